@@ -1,0 +1,1 @@
+//! File formats (placeholder until the I/O module lands).

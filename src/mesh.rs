@@ -1,0 +1,95 @@
+//! The indexed triangle mesh that every stage reads and writes. A point cloud is a `Mesh`
+//! with no triangles.
+
+use crate::error::{Error, Result};
+use glam::Vec3;
+
+/// An indexed triangle mesh, or a point cloud when `triangles` is empty.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Per-vertex normals, when the source has them (same length as `positions`).
+    pub normals: Option<Vec<Vec3>>,
+    /// Triangles as counter-clockwise vertex index triples (the input's winding is kept).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// An axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The box of `points`, or `None` when there are none.
+    pub fn of(points: &[Vec3]) -> Option<Aabb> {
+        let first = *points.first()?;
+        let (min, max) = points
+            .iter()
+            .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        Some(Aabb { min, max })
+    }
+
+    /// Length of the diagonal: the unit all relative thresholds are measured in.
+    pub fn diagonal(&self) -> f32 {
+        (self.max - self.min).length()
+    }
+
+    pub fn center(&self) -> Vec3 {
+        0.5 * (self.min + self.max)
+    }
+}
+
+impl Mesh {
+    /// A point cloud (no triangles), with or without normals.
+    pub fn from_points(positions: Vec<Vec3>, normals: Option<Vec<Vec3>>) -> Mesh {
+        Mesh {
+            positions,
+            normals,
+            triangles: Vec::new(),
+        }
+    }
+
+    pub fn is_point_cloud(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    pub fn bounds(&self) -> Option<Aabb> {
+        Aabb::of(&self.positions)
+    }
+
+    /// Checks what every algorithm relies on: finite coordinates, normals (if any) as many as
+    /// positions and finite, triangle indices in range. The error names the first offender.
+    pub fn check(&self) -> Result<()> {
+        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::input(format!(
+                "vertex {i} has a NaN or infinite coordinate"
+            )));
+        }
+        if let Some(normals) = &self.normals {
+            if normals.len() != self.positions.len() {
+                return Err(Error::input(format!(
+                    "{} normals for {} vertices",
+                    normals.len(),
+                    self.positions.len()
+                )));
+            }
+            if let Some(i) = normals.iter().position(|n| !n.is_finite()) {
+                return Err(Error::input(format!(
+                    "normal {i} has a NaN or infinite component"
+                )));
+            }
+        }
+        let n = self.positions.len() as u64;
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if let Some(&bad) = tri.iter().find(|&&i| u64::from(i) >= n) {
+                return Err(Error::input(format!(
+                    "triangle {t} uses vertex {bad}, but there are only {n} vertices"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
