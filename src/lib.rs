@@ -7,8 +7,18 @@
 
 pub mod error;
 pub mod io;
+mod linalg;
 pub mod mesh;
+pub mod progress;
+pub mod quadric;
+pub mod samples;
 pub mod shapes;
+pub mod simplify;
+pub mod tree;
 
 pub use error::{Error, Result};
 pub use mesh::{Aabb, Mesh};
+pub use progress::{Progress, Threads};
+pub use samples::{MeshSampling, SampleSet};
+pub use simplify::{simplify, SimplifyParams, SimplifyStats};
+pub use tree::{Metric, TreeKind, TreeParams, VsTree};

@@ -1,0 +1,471 @@
+//! Construction (paper §3.2): recursive from the samples' bounding cube. A cell whose error is
+//! within the threshold is a leaf; otherwise it becomes a T-node if the height-field indicator
+//! holds (and is split 1-to-4 in its plane from then on), else it is split 1-to-8.
+//!
+//! Parallel and deterministic: nodes with more than [`FRONTIER`] samples are split on the
+//! calling thread (their per-sample sums in fixed-size parallel chunks); the smaller subtrees
+//! below them are then built independently in parallel and appended in a fixed order. Nothing
+//! depends on the number of threads, so the tree is identical for 1 or N threads.
+
+use super::indicator::{frame, is_height_field};
+use super::{Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
+use crate::error::{Error, Result};
+use crate::mesh::Aabb;
+use crate::progress::{Progress, Threads};
+use crate::quadric::CellStats;
+use crate::samples::SampleSet;
+use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
+
+/// Nodes with more samples than this are split before the parallel phase.
+const FRONTIER: u32 = 32 * 1024;
+/// Chunk size of the parallel per-node sums (fixed, so float sums are reproducible).
+const STATS_CHUNK: usize = 1 << 15;
+
+/// Builds the tree `params` describes over `samples`.
+pub fn build(
+    samples: &SampleSet,
+    params: &TreeParams,
+    threads: &Threads,
+    progress: &mut Progress,
+) -> Result<VsTree> {
+    params.check()?;
+    check_samples(samples)?;
+    progress.report(0.0, "building tree")?;
+    let bounds = Aabb::of(&samples.positions).ok_or_else(|| Error::input("no samples"))?;
+    let diagonal = bounds.diagonal();
+    let extent = (bounds.max - bounds.min).max_element();
+    let center = bounds.center();
+    // Enlarged a little so no sample sits exactly on the root's border; never zero.
+    let half = 0.5 * extent * (1.0 + 1e-4) + 1e-6 * (1.0 + center.abs().max_element());
+    let builder = Builder {
+        params: *params,
+        origin: center.as_dvec3(),
+        abs_error: params.error * f64::from(diagonal).powi(2),
+        min_half: (0.5 * params.min_cell_size * f64::from(diagonal)) as f32,
+    };
+
+    let mut work: Vec<TreeSample> = threads.run(|| {
+        (samples.positions.par_iter(), samples.normals.par_iter())
+            .into_par_iter()
+            .enumerate()
+            .map(|(i, (&position, &normal))| TreeSample {
+                position,
+                normal,
+                index: i as u32,
+            })
+            .collect()
+    });
+    let root = Node {
+        start: 0,
+        count: work.len() as u32,
+        first_child: 0,
+        parent: 0,
+        center,
+        half,
+        frame: NO_FRAME,
+        kind: NodeKind::Volume,
+        depth: 0,
+        child_count: 0,
+        slot: 0,
+    };
+
+    // Phase 1: the large nodes, on this thread.
+    let mut part = Part {
+        nodes: vec![root],
+        frames: Vec::new(),
+        shared_frames: &[],
+        samples: &mut work,
+        sample_base: 0,
+    };
+    let mut pending = builder.grow(&mut part, 0, Some(threads));
+    let Part {
+        mut nodes,
+        mut frames,
+        ..
+    } = part;
+    progress.report(0.2, "building tree")?;
+
+    // Phase 2: the subtrees below them, in parallel, in batches so progress can be reported.
+    pending.sort_by_key(|&i| nodes[i].start);
+    let jobs = carve(&mut work, pending.iter().map(|&i| (i, nodes[i])));
+    let total = samples.len().max(1) as f32;
+    let mut done = 0usize;
+    let mut results = Vec::with_capacity(jobs.len());
+    let mut jobs = jobs.into_iter().peekable();
+    while jobs.peek().is_some() {
+        let mut batch = Vec::new();
+        let mut batch_samples = 0usize;
+        while let Some(job) = jobs.next_if(|_| batch_samples < samples.len() / 16 + 1) {
+            batch_samples += job.2.len();
+            batch.push(job);
+        }
+        let shared: &[Frame] = &frames;
+        results.extend(threads.run(|| {
+            batch
+                .into_par_iter()
+                .map(|(i, node, slice)| {
+                    let mut part = Part {
+                        nodes: vec![node],
+                        frames: Vec::new(),
+                        shared_frames: shared,
+                        samples: slice,
+                        sample_base: node.start,
+                    };
+                    builder.grow(&mut part, 0, None);
+                    (i, part.nodes, part.frames)
+                })
+                .collect::<Vec<_>>()
+        }));
+        done += batch_samples;
+        progress.report(0.2 + 0.8 * done as f32 / total, "building tree")?;
+    }
+
+    let shared_len = frames.len() as u32;
+    for (i, local_nodes, local_frames) in results {
+        append_part(
+            &mut nodes,
+            &mut frames,
+            i,
+            local_nodes,
+            local_frames,
+            shared_len,
+        );
+    }
+    Ok(VsTree {
+        nodes,
+        frames,
+        samples: work,
+        diagonal,
+        params: *params,
+    })
+}
+
+fn check_samples(samples: &SampleSet) -> Result<()> {
+    if samples.is_empty() {
+        return Err(Error::input("no samples"));
+    }
+    if samples.normals.len() != samples.len() {
+        return Err(Error::input(format!(
+            "{} normals for {} samples",
+            samples.normals.len(),
+            samples.len()
+        )));
+    }
+    if samples.len() >= u32::MAX as usize {
+        return Err(Error::TooLarge(format!(
+            "{} samples (at most {})",
+            samples.len(),
+            u32::MAX - 1
+        )));
+    }
+    if let Some(i) = samples.positions.iter().position(|p| !p.is_finite()) {
+        return Err(Error::input(format!(
+            "sample {i} has a NaN or infinite coordinate"
+        )));
+    }
+    if let Some(i) = samples.normals.iter().position(|n| !n.is_finite()) {
+        return Err(Error::input(format!(
+            "sample {i} has a NaN or infinite normal"
+        )));
+    }
+    Ok(())
+}
+
+/// A piece of the tree under construction: its nodes, the frames it created, and the samples
+/// it owns. Frames numbered below `shared_frames.len()` were made earlier; a local frame `k`
+/// is numbered `shared_frames.len() + k` until it is appended.
+struct Part<'a> {
+    nodes: Vec<Node>,
+    frames: Vec<Frame>,
+    shared_frames: &'a [Frame],
+    samples: &'a mut [TreeSample],
+    /// Index in the whole sample array of `samples[0]`.
+    sample_base: u32,
+}
+
+impl Part<'_> {
+    fn frame(&self, index: u32) -> &Frame {
+        let shared = self.shared_frames.len();
+        match (index as usize).checked_sub(shared) {
+            Some(local) => &self.frames[local],
+            None => &self.shared_frames[index as usize],
+        }
+    }
+
+    fn slice(&mut self, node: &Node) -> &mut [TreeSample] {
+        let lo = (node.start - self.sample_base) as usize;
+        &mut self.samples[lo..lo + node.count as usize]
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Builder {
+    params: TreeParams,
+    /// Sums are taken relative to this point (the root's centre).
+    origin: DVec3,
+    /// The L2 bound in absolute (squared) units.
+    abs_error: f64,
+    min_half: f32,
+}
+
+impl Builder {
+    /// Processes node `first` and all its descendants, depth first. With `big` set (phase 1),
+    /// nodes with at most [`FRONTIER`] samples are left unprocessed and returned.
+    fn grow(&self, part: &mut Part, first: usize, big: Option<&Threads>) -> Vec<usize> {
+        let mut pending = Vec::new();
+        let mut stack = vec![first];
+        while let Some(i) = stack.pop() {
+            if big.is_some() && part.nodes[i].count <= FRONTIER {
+                pending.push(i);
+                continue;
+            }
+            let children = self.process(part, i, big);
+            stack.extend(children.rev());
+        }
+        pending
+    }
+
+    /// Decides what node `i` is (leaf, T-node, split) and creates its children.
+    fn process(
+        &self,
+        part: &mut Part,
+        i: usize,
+        threads: Option<&Threads>,
+    ) -> std::ops::Range<usize> {
+        let node = part.nodes[i];
+        let origin = self.origin;
+        let stats = {
+            let slice = part.slice(&node);
+            match threads {
+                Some(t) if slice.len() > 2 * STATS_CHUNK => t.run(|| {
+                    let sums: Vec<CellStats> = slice
+                        .par_chunks(STATS_CHUNK)
+                        .map(|c| sum(c, origin))
+                        .collect();
+                    sums.iter().fold(CellStats::default(), |mut acc, s| {
+                        acc.merge(s);
+                        acc
+                    })
+                }),
+                _ => sum(slice, origin),
+            }
+        };
+        let small_enough = match self.params.metric {
+            Metric::L2 => stats.l2_error() <= self.abs_error,
+            Metric::L21 => stats.normal_deviation() <= self.params.error,
+            Metric::Density => stats.count as f64 <= self.params.error,
+        };
+        let splittable = node.count > 1
+            && u32::from(node.depth) < self.params.max_depth
+            && node.half > self.min_half;
+        let split = !small_enough && splittable;
+
+        match node.kind {
+            NodeKind::Volume => {
+                let slice = part.slice(&node);
+                let centroid = (stats.centroid() + origin).as_vec3();
+                let flat = self.params.kind == TreeKind::VsTree
+                    && is_height_field(
+                        slice,
+                        centroid,
+                        stats.mean_normal(),
+                        self.params.d_a,
+                        self.params.d_d,
+                    );
+                if flat {
+                    let f = frame(slice, &stats, origin);
+                    let index = (part.shared_frames.len() + part.frames.len()) as u32;
+                    part.frames.push(f);
+                    let n = &mut part.nodes[i];
+                    n.kind = NodeKind::Transition;
+                    n.frame = index;
+                    if split {
+                        return self.split_quadrants(
+                            part,
+                            i,
+                            Vec3::new(f.square_center.x, f.square_center.y, 0.0),
+                            f.square_half,
+                        );
+                    }
+                } else if split {
+                    return self.split_octants(part, i);
+                }
+            }
+            NodeKind::Surface if split => {
+                return self.split_quadrants(part, i, node.center, node.half)
+            }
+            _ => {}
+        }
+        0..0
+    }
+
+    fn split_octants(&self, part: &mut Part, i: usize) -> std::ops::Range<usize> {
+        let node = part.nodes[i];
+        let c = node.center;
+        let counts = partition::<8>(part.slice(&node), |s| {
+            (s.position.x >= c.x) as usize
+                | ((s.position.y >= c.y) as usize) << 1
+                | ((s.position.z >= c.z) as usize) << 2
+        });
+        let q = 0.5 * node.half;
+        add_children(part, i, &counts, NodeKind::Volume, NO_FRAME, |slot| {
+            let sign = |bit: usize| if slot >> bit & 1 == 1 { q } else { -q };
+            (c + Vec3::new(sign(0), sign(1), sign(2)), q)
+        })
+    }
+
+    /// Splits node `i` (a T-node or S-node) into the quadrants of the square `center ± half`
+    /// (in its frame's plane coordinates).
+    fn split_quadrants(
+        &self,
+        part: &mut Part,
+        i: usize,
+        center: Vec3,
+        half: f32,
+    ) -> std::ops::Range<usize> {
+        let node = part.nodes[i];
+        let f = *part.frame(node.frame);
+        let c = center.truncate();
+        let counts = partition::<4>(part.slice(&node), |s| {
+            let q: Vec2 = f.project(s.position);
+            (q.x >= c.x) as usize | ((q.y >= c.y) as usize) << 1
+        });
+        let q = 0.5 * half;
+        add_children(part, i, &counts, NodeKind::Surface, node.frame, |slot| {
+            let sign = |bit: usize| if slot >> bit & 1 == 1 { q } else { -q };
+            (Vec3::new(c.x + sign(0), c.y + sign(1), 0.0), q)
+        })
+    }
+}
+
+fn sum(samples: &[TreeSample], origin: DVec3) -> CellStats {
+    let mut stats = CellStats::default();
+    for s in samples {
+        stats.add(s.position.as_dvec3() - origin, s.normal.as_dvec3());
+    }
+    stats
+}
+
+/// Appends one child per non-empty bucket (in bucket order) to node `i`.
+fn add_children(
+    part: &mut Part,
+    i: usize,
+    counts: &[u32],
+    kind: NodeKind,
+    frame: u32,
+    cell: impl Fn(usize) -> (Vec3, f32),
+) -> std::ops::Range<usize> {
+    let parent = part.nodes[i];
+    let first = part.nodes.len();
+    let mut start = parent.start;
+    for (slot, &count) in counts.iter().enumerate() {
+        if count > 0 {
+            let (center, half) = cell(slot);
+            part.nodes.push(Node {
+                start,
+                count,
+                first_child: 0,
+                parent: i as u32,
+                center,
+                half,
+                frame,
+                kind,
+                depth: parent.depth + 1,
+                child_count: 0,
+                slot: slot as u8,
+            });
+        }
+        start += count;
+    }
+    let child_count = (part.nodes.len() - first) as u8;
+    let n = &mut part.nodes[i];
+    n.first_child = first as u32;
+    n.child_count = child_count;
+    first..part.nodes.len()
+}
+
+/// Reorders `samples` by bucket in place (American flag sort) and returns the bucket sizes.
+fn partition<const B: usize>(
+    samples: &mut [TreeSample],
+    key: impl Fn(&TreeSample) -> usize,
+) -> [u32; B] {
+    let mut counts = [0u32; B];
+    for s in samples.iter() {
+        counts[key(s)] += 1;
+    }
+    let mut next = [0usize; B];
+    let mut end = [0usize; B];
+    let mut offset = 0usize;
+    for b in 0..B {
+        next[b] = offset;
+        offset += counts[b] as usize;
+        end[b] = offset;
+    }
+    for b in 0..B {
+        while next[b] < end[b] {
+            let k = key(&samples[next[b]]);
+            if k == b {
+                next[b] += 1;
+            } else {
+                samples.swap(next[b], next[k]);
+                next[k] += 1;
+            }
+        }
+    }
+    counts
+}
+
+/// Splits `samples` into the disjoint ranges of the given nodes (sorted by start).
+fn carve(
+    samples: &mut [TreeSample],
+    nodes: impl Iterator<Item = (usize, Node)>,
+) -> Vec<(usize, Node, &mut [TreeSample])> {
+    let mut rest = samples;
+    let mut consumed = 0usize;
+    let mut out = Vec::new();
+    for (i, node) in nodes {
+        let skip = node.start as usize - consumed;
+        let (_, tail) = std::mem::take(&mut rest).split_at_mut(skip);
+        let (mine, tail) = tail.split_at_mut(node.count as usize);
+        rest = tail;
+        consumed = node.start as usize + node.count as usize;
+        out.push((i, node, mine));
+    }
+    out
+}
+
+/// Appends a part built in phase 2 under node `i`: its local node 0 replaces node `i`, the
+/// others are appended with their indices shifted; local frames likewise.
+fn append_part(
+    nodes: &mut Vec<Node>,
+    frames: &mut Vec<Frame>,
+    i: usize,
+    local: Vec<Node>,
+    local_frames: Vec<Frame>,
+    shared: u32,
+) {
+    let node_base = nodes.len() as u32;
+    let frame_base = frames.len() as u32;
+    let node_index = |j: u32| if j == 0 { i as u32 } else { node_base + j - 1 };
+    let frame_index = |f: u32| {
+        if f == NO_FRAME || f < shared {
+            f
+        } else {
+            frame_base + (f - shared)
+        }
+    };
+    for (j, mut n) in local.into_iter().enumerate() {
+        if n.child_count > 0 {
+            n.first_child = node_index(n.first_child);
+        }
+        n.frame = frame_index(n.frame);
+        if j == 0 {
+            nodes[i] = n; // keeps its parent, which is already global
+        } else {
+            n.parent = node_index(n.parent);
+            nodes.push(n);
+        }
+    }
+    frames.extend(local_frames);
+}

@@ -1,0 +1,303 @@
+//! The Volume-Surface Tree (paper §3): an octree of V-nodes down to the T-layer, where each
+//! T-node carries a local frame and roots a quadtree of S-nodes in its tangent plane.
+//!
+//! Storage is flat: `nodes[0]` is the root, a node's children are contiguous in `nodes`, and
+//! the samples are reordered once so that every node owns the contiguous range
+//! `samples[start .. start + count]`.
+
+mod build;
+mod indicator;
+mod locate;
+mod validate;
+
+use crate::error::{Error, Result};
+use glam::{Vec2, Vec3};
+
+pub use build::build;
+
+/// Which hierarchy to build.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TreeKind {
+    /// Octree above the T-layer, quadtrees below it (the paper's structure).
+    #[default]
+    VsTree,
+    /// A plain octree with the same metric, thresholds and sample order: the baseline.
+    Octree,
+}
+
+/// The error metric that decides whether a cell is split (paper §3.2, "Error metrics").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Metric {
+    /// Quadric error (Garland-Heckbert): RMS distance from the cell's quadric minimiser to the
+    /// samples' tangent planes, relative to the bounding-box diagonal.
+    #[default]
+    L2,
+    /// Normal deviation (Cohen-Steiner et al. 2004): mean of ‖nⱼ − n̂‖² over the cell's samples
+    /// (unitless, 0 = flat, at most 4).
+    L21,
+    /// Sample count: a cell with at most `error` samples is a leaf (a cheap proxy for huge inputs).
+    Density,
+}
+
+/// Parameters of the tree. `error` is read according to `metric`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TreeParams {
+    pub kind: TreeKind,
+    pub metric: Metric,
+    /// Split threshold: L2 relative to the squared bounding-box diagonal, L2,1 unitless, Density
+    /// a sample count.
+    pub error: f64,
+    /// Height-field indicator, normal cone: every normal must satisfy nⱼ·n̄ > d_a. In [0, 1].
+    pub d_a: f32,
+    /// Height-field indicator, displacement: |(pⱼ − c)·n̄| / max‖pₖ − c‖ < d_d. In [0, 1].
+    pub d_d: f32,
+    /// Deepest level of the whole tree (octree and quadtree levels counted together), 1-30.
+    pub max_depth: u32,
+    /// Cells smaller than this (relative to the diagonal) are not split: guards against
+    /// duplicate points. In [0, 1).
+    pub min_cell_size: f64,
+}
+
+impl Default for TreeParams {
+    fn default() -> Self {
+        TreeParams {
+            kind: TreeKind::VsTree,
+            metric: Metric::L2,
+            error: 1e-3,
+            d_a: 0.0,
+            d_d: 1.0 / 6.0,
+            max_depth: 24,
+            min_cell_size: 1e-7,
+        }
+    }
+}
+
+/// The deepest level supported: cube sizes stay representable in `f32` well past it.
+pub const MAX_DEPTH: u32 = 30;
+
+impl TreeParams {
+    /// Rejects values outside their documented ranges, naming the parameter.
+    pub fn check(&self) -> Result<()> {
+        let positive = self.error.is_finite() && self.error > 0.0;
+        match self.metric {
+            Metric::Density if !(positive && self.error >= 1.0) => {
+                return Err(Error::param(
+                    "error",
+                    format!("{} samples per cell: must be at least 1", self.error),
+                ))
+            }
+            _ if !positive => {
+                return Err(Error::param(
+                    "error",
+                    format!("{}: must be a finite number > 0", self.error),
+                ))
+            }
+            _ => {}
+        }
+        if !(0.0..=1.0).contains(&self.d_a) {
+            return Err(Error::param(
+                "d_a",
+                format!("{}: must be in [0, 1]", self.d_a),
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.d_d) {
+            return Err(Error::param(
+                "d_d",
+                format!("{}: must be in [0, 1]", self.d_d),
+            ));
+        }
+        if !(1..=MAX_DEPTH).contains(&self.max_depth) {
+            return Err(Error::param(
+                "max_depth",
+                format!("{}: must be in 1..={MAX_DEPTH}", self.max_depth),
+            ));
+        }
+        if !(self.min_cell_size.is_finite() && (0.0..1.0).contains(&self.min_cell_size)) {
+            return Err(Error::param(
+                "min_cell_size",
+                format!("{}: must be in [0, 1)", self.min_cell_size),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The three kinds of node (paper §3.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum NodeKind {
+    /// An octree cell: 0 or 8 (non-empty) children, V- or T-nodes.
+    Volume = 0,
+    /// A leaf of the 3D hierarchy and root of a 2D one: 0 or 4 S-node children.
+    Transition = 1,
+    /// A quadtree cell in its T-node's plane: 0 or 4 S-node children.
+    Surface = 2,
+}
+
+/// A node. For V- and T-nodes the cell is the cube `center ± half`; for S-nodes it is the
+/// square `(center.x, center.y) ± half` in the (u, v) coordinates of frame `frame`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Node {
+    /// First sample of the node's range in [`VsTree::samples`].
+    pub start: u32,
+    pub count: u32,
+    /// Index of the first child; children are `first_child .. first_child + child_count`.
+    pub first_child: u32,
+    /// Parent index (the root is its own parent).
+    pub parent: u32,
+    pub center: Vec3,
+    pub half: f32,
+    /// Index into [`VsTree::frames`] for T- and S-nodes, [`NO_FRAME`] for V-nodes.
+    pub frame: u32,
+    pub kind: NodeKind,
+    pub depth: u8,
+    pub child_count: u8,
+    /// Which octant (bits x, y, z) or quadrant (bits u, v) of the parent this node is.
+    pub slot: u8,
+}
+
+/// `Node::frame` of a V-node.
+pub const NO_FRAME: u32 = u32::MAX;
+
+impl Node {
+    pub fn is_leaf(&self) -> bool {
+        self.child_count == 0
+    }
+
+    pub fn range(&self) -> std::ops::Range<usize> {
+        self.start as usize..(self.start + self.count) as usize
+    }
+
+    pub fn children(&self) -> std::ops::Range<usize> {
+        self.first_child as usize..(self.first_child + u32::from(self.child_count)) as usize
+    }
+
+    /// The centre of the square for an S-node, in its frame's (u, v) coordinates.
+    pub fn center_uv(&self) -> Vec2 {
+        self.center.truncate()
+    }
+}
+
+/// A T-node's local frame {n, u, v} at the centroid of its samples, and the bounding square of
+/// their projections (the root of its quadtree) in (u, v) coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    pub origin: Vec3,
+    pub normal: Vec3,
+    pub u: Vec3,
+    pub v: Vec3,
+    pub square_center: Vec2,
+    pub square_half: f32,
+}
+
+impl Frame {
+    /// (u, v) coordinates of the projection of `p` onto the frame's plane.
+    #[inline]
+    pub fn project(&self, p: Vec3) -> Vec2 {
+        let d = p - self.origin;
+        Vec2::new(d.dot(self.u), d.dot(self.v))
+    }
+
+    /// Signed height of `p` above the plane.
+    #[inline]
+    pub fn height(&self, p: Vec3) -> f32 {
+        (p - self.origin).dot(self.normal)
+    }
+
+    /// The 3D point at plane coordinates `uv` and height `h`.
+    pub fn point(&self, uv: Vec2, h: f32) -> Vec3 {
+        self.origin + self.u * uv.x + self.v * uv.y + self.normal * h
+    }
+}
+
+/// A sample in tree order; `index` is its position in the [`crate::SampleSet`] it came from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TreeSample {
+    pub position: Vec3,
+    pub normal: Vec3,
+    pub index: u32,
+}
+
+/// A built tree.
+#[derive(Clone, Debug)]
+pub struct VsTree {
+    pub nodes: Vec<Node>,
+    pub frames: Vec<Frame>,
+    pub samples: Vec<TreeSample>,
+    /// Diagonal of the samples' bounding box: the unit of relative thresholds.
+    pub diagonal: f32,
+    pub params: TreeParams,
+}
+
+/// Figures that describe a tree.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TreeStats {
+    pub samples: usize,
+    pub nodes: usize,
+    pub v_nodes: usize,
+    pub t_nodes: usize,
+    pub s_nodes: usize,
+    /// Leaves = clusters.
+    pub leaves: usize,
+    pub max_depth: u32,
+    /// Shallowest and deepest T-node (0, 0 when there is none).
+    pub t_depth_min: u32,
+    pub t_depth_max: u32,
+    /// Mean and variance of the number of samples per leaf.
+    pub leaf_size_mean: f64,
+    pub leaf_size_variance: f64,
+}
+
+impl VsTree {
+    pub fn root(&self) -> &Node {
+        &self.nodes[0]
+    }
+
+    /// Indices of the leaves, in node order: leaf `k` of this iterator is cluster `k`.
+    pub fn leaves(&self) -> impl Iterator<Item = usize> + '_ {
+        self.nodes
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| n.is_leaf())
+            .map(|(i, _)| i)
+    }
+
+    pub fn samples_of(&self, node: &Node) -> &[TreeSample] {
+        &self.samples[node.range()]
+    }
+
+    pub fn stats(&self) -> TreeStats {
+        let mut s = TreeStats {
+            samples: self.samples.len(),
+            nodes: self.nodes.len(),
+            ..Default::default()
+        };
+        let (mut t_min, mut t_max) = (u32::MAX, 0);
+        let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+        for node in &self.nodes {
+            match node.kind {
+                NodeKind::Volume => s.v_nodes += 1,
+                NodeKind::Transition => {
+                    s.t_nodes += 1;
+                    t_min = t_min.min(node.depth.into());
+                    t_max = t_max.max(node.depth.into());
+                }
+                NodeKind::Surface => s.s_nodes += 1,
+            }
+            s.max_depth = s.max_depth.max(node.depth.into());
+            if node.is_leaf() {
+                s.leaves += 1;
+                sum += f64::from(node.count);
+                sum_sq += f64::from(node.count).powi(2);
+            }
+        }
+        if s.t_nodes > 0 {
+            (s.t_depth_min, s.t_depth_max) = (t_min, t_max);
+        }
+        if s.leaves > 0 {
+            s.leaf_size_mean = sum / s.leaves as f64;
+            s.leaf_size_variance = (sum_sq / s.leaves as f64 - s.leaf_size_mean.powi(2)).max(0.0);
+        }
+        s
+    }
+}
