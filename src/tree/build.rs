@@ -1,13 +1,15 @@
 //! Construction (paper §3.2): recursive from the samples' bounding cube. A cell whose error is
 //! within the threshold is a leaf; otherwise it becomes a T-node if the height-field indicator
-//! holds (and is split 1-to-4 in its plane from then on), else it is split 1-to-8.
+//! holds (and is split 1-to-4 in its plane from then on), else it is split 1-to-8. (A leaf that
+//! passes the indicator is a T-node too, with no children, so the T-layer covers the surface.)
 //!
 //! Parallel and deterministic: nodes with more than [`FRONTIER`] samples are split on the
-//! calling thread (their per-sample sums in fixed-size parallel chunks); the smaller subtrees
-//! below them are then built independently in parallel and appended in a fixed order. Nothing
+//! calling thread (their partitions in fixed-size parallel chunks); the smaller subtrees below
+//! them are then built independently in parallel and appended in a fixed order. Nothing
 //! depends on the number of threads, so the tree is identical for 1 or N threads.
 
 use super::indicator::{frame, is_height_field};
+use super::partition::partition;
 use super::{Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
 use crate::error::{Error, Result};
 use crate::mesh::Aabb;
@@ -19,8 +21,11 @@ use rayon::prelude::*;
 
 /// Nodes with more samples than this are split before the parallel phase.
 const FRONTIER: u32 = 32 * 1024;
-/// Chunk size of the parallel per-node sums (fixed, so float sums are reproducible).
+/// Chunk size of the parallel sums over the root (fixed, so float sums are reproducible).
 const STATS_CHUNK: usize = 1 << 15;
+
+/// A node index with the sums of its samples (computed while partitioning its parent).
+type Pending = (usize, CellStats);
 
 /// Builds the tree `params` describes over `samples`.
 pub fn build(
@@ -69,6 +74,16 @@ pub fn build(
         child_count: 0,
         slot: 0,
     };
+    let root_stats = threads.run(|| {
+        let sums: Vec<CellStats> = work
+            .par_chunks(STATS_CHUNK)
+            .map(|c| sum(c, builder.origin))
+            .collect();
+        sums.iter().fold(CellStats::default(), |mut total, s| {
+            total.merge(s);
+            total
+        })
+    });
 
     // Phase 1: the large nodes, on this thread.
     let mut part = Part {
@@ -78,7 +93,7 @@ pub fn build(
         samples: &mut work,
         sample_base: 0,
     };
-    let mut pending = builder.grow(&mut part, 0, Some(threads));
+    let mut pending = builder.grow(&mut part, (0, root_stats), Some(threads));
     let Part {
         mut nodes,
         mut frames,
@@ -87,8 +102,11 @@ pub fn build(
     progress.report(0.2, "building tree")?;
 
     // Phase 2: the subtrees below them, in parallel, in batches so progress can be reported.
-    pending.sort_by_key(|&i| nodes[i].start);
-    let jobs = carve(&mut work, pending.iter().map(|&i| (i, nodes[i])));
+    pending.sort_by_key(|&(i, _)| nodes[i].start);
+    let jobs = carve(
+        &mut work,
+        pending.iter().map(|&(i, stats)| (i, nodes[i], stats)),
+    );
     let total = samples.len().max(1) as f32;
     let mut done = 0usize;
     let mut results = Vec::with_capacity(jobs.len());
@@ -97,23 +115,23 @@ pub fn build(
         let mut batch = Vec::new();
         let mut batch_samples = 0usize;
         while let Some(job) = jobs.next_if(|_| batch_samples < samples.len() / 16 + 1) {
-            batch_samples += job.2.len();
+            batch_samples += job.node.count as usize;
             batch.push(job);
         }
         let shared: &[Frame] = &frames;
         results.extend(threads.run(|| {
             batch
                 .into_par_iter()
-                .map(|(i, node, slice)| {
+                .map(|job| {
                     let mut part = Part {
-                        nodes: vec![node],
+                        nodes: vec![job.node],
                         frames: Vec::new(),
                         shared_frames: shared,
-                        samples: slice,
-                        sample_base: node.start,
+                        samples: job.samples,
+                        sample_base: job.node.start,
                     };
-                    builder.grow(&mut part, 0, None);
-                    (i, part.nodes, part.frames)
+                    builder.grow(&mut part, (0, job.stats), None);
+                    (job.index, part.nodes, part.frames)
                 })
                 .collect::<Vec<_>>()
         }));
@@ -199,6 +217,14 @@ impl Part<'_> {
     }
 }
 
+/// One subtree of phase 2: the node that roots it, its sums, and the samples it owns.
+struct Job<'a> {
+    index: usize,
+    node: Node,
+    stats: CellStats,
+    samples: &'a mut [TreeSample],
+}
+
 #[derive(Clone, Copy)]
 struct Builder {
     params: TreeParams,
@@ -212,45 +238,30 @@ struct Builder {
 impl Builder {
     /// Processes node `first` and all its descendants, depth first. With `big` set (phase 1),
     /// nodes with at most [`FRONTIER`] samples are left unprocessed and returned.
-    fn grow(&self, part: &mut Part, first: usize, big: Option<&Threads>) -> Vec<usize> {
+    fn grow(&self, part: &mut Part, first: Pending, big: Option<&Threads>) -> Vec<Pending> {
         let mut pending = Vec::new();
         let mut stack = vec![first];
-        while let Some(i) = stack.pop() {
+        while let Some((i, stats)) = stack.pop() {
             if big.is_some() && part.nodes[i].count <= FRONTIER {
-                pending.push(i);
+                pending.push((i, stats));
                 continue;
             }
-            let children = self.process(part, i, big);
-            stack.extend(children.rev());
+            let children = self.process(part, i, &stats, big);
+            stack.extend(children.into_iter().rev());
         }
         pending
     }
 
-    /// Decides what node `i` is (leaf, T-node, split) and creates its children.
+    /// Decides what node `i` (whose samples sum to `stats`) is: a leaf, a T-node, or split; and
+    /// creates its children, returned with their sums.
     fn process(
         &self,
         part: &mut Part,
         i: usize,
+        stats: &CellStats,
         threads: Option<&Threads>,
-    ) -> std::ops::Range<usize> {
+    ) -> Vec<Pending> {
         let node = part.nodes[i];
-        let origin = self.origin;
-        let stats = {
-            let slice = part.slice(&node);
-            match threads {
-                Some(t) if slice.len() > 2 * STATS_CHUNK => t.run(|| {
-                    let sums: Vec<CellStats> = slice
-                        .par_chunks(STATS_CHUNK)
-                        .map(|c| sum(c, origin))
-                        .collect();
-                    sums.iter().fold(CellStats::default(), |mut acc, s| {
-                        acc.merge(s);
-                        acc
-                    })
-                }),
-                _ => sum(slice, origin),
-            }
-        };
         let small_enough = match self.params.metric {
             Metric::L2 => stats.l2_error() <= self.abs_error,
             Metric::L21 => stats.normal_deviation() <= self.params.error,
@@ -264,7 +275,7 @@ impl Builder {
         match node.kind {
             NodeKind::Volume => {
                 let slice = part.slice(&node);
-                let centroid = (stats.centroid() + origin).as_vec3();
+                let centroid = (stats.centroid() + self.origin).as_vec3();
                 let flat = self.params.kind == TreeKind::VsTree
                     && is_height_field(
                         slice,
@@ -274,42 +285,38 @@ impl Builder {
                         self.params.d_d,
                     );
                 if flat {
-                    let f = frame(slice, &stats, origin);
+                    let f = frame(slice, stats, self.origin);
                     let index = (part.shared_frames.len() + part.frames.len()) as u32;
                     part.frames.push(f);
                     let n = &mut part.nodes[i];
                     n.kind = NodeKind::Transition;
                     n.frame = index;
                     if split {
-                        return self.split_quadrants(
-                            part,
-                            i,
-                            Vec3::new(f.square_center.x, f.square_center.y, 0.0),
-                            f.square_half,
-                        );
+                        let center = Vec3::new(f.square_center.x, f.square_center.y, 0.0);
+                        return self.split_quadrants(part, i, center, f.square_half, threads);
                     }
                 } else if split {
-                    return self.split_octants(part, i);
+                    return self.split_octants(part, i, threads);
                 }
             }
             NodeKind::Surface if split => {
-                return self.split_quadrants(part, i, node.center, node.half)
+                return self.split_quadrants(part, i, node.center, node.half, threads)
             }
             _ => {}
         }
-        0..0
+        Vec::new()
     }
 
-    fn split_octants(&self, part: &mut Part, i: usize) -> std::ops::Range<usize> {
+    fn split_octants(&self, part: &mut Part, i: usize, threads: Option<&Threads>) -> Vec<Pending> {
         let node = part.nodes[i];
         let c = node.center;
-        let counts = partition::<8>(part.slice(&node), |s| {
-            (s.position.x >= c.x) as usize
-                | ((s.position.y >= c.y) as usize) << 1
-                | ((s.position.z >= c.z) as usize) << 2
-        });
+        let octant = |s: &TreeSample| {
+            let p = s.position;
+            (p.x >= c.x) as usize | ((p.y >= c.y) as usize) << 1 | ((p.z >= c.z) as usize) << 2
+        };
+        let stats = partition::<8>(part.slice(&node), octant, self.origin, threads);
         let q = 0.5 * node.half;
-        add_children(part, i, &counts, NodeKind::Volume, NO_FRAME, |slot| {
+        add_children(part, i, &stats, NodeKind::Volume, NO_FRAME, |slot| {
             let sign = |bit: usize| if slot >> bit & 1 == 1 { q } else { -q };
             (c + Vec3::new(sign(0), sign(1), sign(2)), q)
         })
@@ -323,16 +330,18 @@ impl Builder {
         i: usize,
         center: Vec3,
         half: f32,
-    ) -> std::ops::Range<usize> {
+        threads: Option<&Threads>,
+    ) -> Vec<Pending> {
         let node = part.nodes[i];
         let f = *part.frame(node.frame);
         let c = center.truncate();
-        let counts = partition::<4>(part.slice(&node), |s| {
+        let quadrant = |s: &TreeSample| {
             let q: Vec2 = f.project(s.position);
             (q.x >= c.x) as usize | ((q.y >= c.y) as usize) << 1
-        });
+        };
+        let stats = partition::<4>(part.slice(&node), quadrant, self.origin, threads);
         let q = 0.5 * half;
-        add_children(part, i, &counts, NodeKind::Surface, node.frame, |slot| {
+        add_children(part, i, &stats, NodeKind::Surface, node.frame, |slot| {
             let sign = |bit: usize| if slot >> bit & 1 == 1 { q } else { -q };
             (Vec3::new(c.x + sign(0), c.y + sign(1), 0.0), q)
         })
@@ -351,17 +360,20 @@ fn sum(samples: &[TreeSample], origin: DVec3) -> CellStats {
 fn add_children(
     part: &mut Part,
     i: usize,
-    counts: &[u32],
+    buckets: &[CellStats],
     kind: NodeKind,
     frame: u32,
     cell: impl Fn(usize) -> (Vec3, f32),
-) -> std::ops::Range<usize> {
+) -> Vec<Pending> {
     let parent = part.nodes[i];
     let first = part.nodes.len();
     let mut start = parent.start;
-    for (slot, &count) in counts.iter().enumerate() {
+    let mut children = Vec::with_capacity(buckets.len());
+    for (slot, stats) in buckets.iter().enumerate() {
+        let count = stats.count as u32;
         if count > 0 {
             let (center, half) = cell(slot);
+            children.push((part.nodes.len(), *stats));
             part.nodes.push(Node {
                 start,
                 count,
@@ -378,61 +390,34 @@ fn add_children(
         }
         start += count;
     }
-    let child_count = (part.nodes.len() - first) as u8;
     let n = &mut part.nodes[i];
     n.first_child = first as u32;
-    n.child_count = child_count;
-    first..part.nodes.len()
-}
-
-/// Reorders `samples` by bucket in place (American flag sort) and returns the bucket sizes.
-fn partition<const B: usize>(
-    samples: &mut [TreeSample],
-    key: impl Fn(&TreeSample) -> usize,
-) -> [u32; B] {
-    let mut counts = [0u32; B];
-    for s in samples.iter() {
-        counts[key(s)] += 1;
-    }
-    let mut next = [0usize; B];
-    let mut end = [0usize; B];
-    let mut offset = 0usize;
-    for b in 0..B {
-        next[b] = offset;
-        offset += counts[b] as usize;
-        end[b] = offset;
-    }
-    for b in 0..B {
-        while next[b] < end[b] {
-            let k = key(&samples[next[b]]);
-            if k == b {
-                next[b] += 1;
-            } else {
-                samples.swap(next[b], next[k]);
-                next[k] += 1;
-            }
-        }
-    }
-    counts
+    n.child_count = children.len() as u8;
+    children
 }
 
 /// Splits `samples` into the disjoint ranges of the given nodes (sorted by start).
 fn carve(
     samples: &mut [TreeSample],
-    nodes: impl Iterator<Item = (usize, Node)>,
-) -> Vec<(usize, Node, &mut [TreeSample])> {
+    nodes: impl Iterator<Item = (usize, Node, CellStats)>,
+) -> Vec<Job<'_>> {
     let mut rest = samples;
     let mut consumed = 0usize;
-    let mut out = Vec::new();
-    for (i, node) in nodes {
+    let mut jobs = Vec::new();
+    for (index, node, stats) in nodes {
         let skip = node.start as usize - consumed;
         let (_, tail) = std::mem::take(&mut rest).split_at_mut(skip);
         let (mine, tail) = tail.split_at_mut(node.count as usize);
         rest = tail;
         consumed = node.start as usize + node.count as usize;
-        out.push((i, node, mine));
+        jobs.push(Job {
+            index,
+            node,
+            stats,
+            samples: mine,
+        });
     }
-    out
+    jobs
 }
 
 /// Appends a part built in phase 2 under node `i`: its local node 0 replaces node `i`, the

@@ -8,6 +8,7 @@
 mod build;
 mod indicator;
 mod locate;
+mod partition;
 mod validate;
 
 use crate::error::{Error, Result};
