@@ -1,1 +1,7 @@
-//! File formats (placeholder until the I/O module lands).
+//! File formats (being built up: shared helpers first).
+
+#![allow(dead_code)]
+
+mod assemble;
+mod atomic;
+mod text;
