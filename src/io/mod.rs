@@ -1,7 +1,8 @@
-//! File formats (being built up: shared helpers first).
+//! File formats (being built up).
 
 #![allow(dead_code)]
 
 mod assemble;
 mod atomic;
+pub mod ply;
 mod text;
