@@ -4,5 +4,8 @@
 
 mod assemble;
 mod atomic;
+pub mod obj;
+pub mod off;
 pub mod ply;
 mod text;
+pub mod xyz;
