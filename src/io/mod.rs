@@ -1,6 +1,6 @@
 //! Reading and writing meshes and point clouds: PLY, OBJ, OFF and XYZ/PWN.
 //!
-//! [`read`] and [`write`] pick the format from the file extension (case-insensitive). Each
+//! [`read()`] and [`write()`] pick the format from the file extension (case-insensitive). Each
 //! format module also has a `parse(bytes, path)` that reads from memory. Readers never panic
 //! on malformed input: they return [`Error::Parse`] naming the file, the place (a line, or an
 //! element item such as `face 3` in binary PLY) and what is wrong. Writers replace the target

@@ -22,6 +22,8 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     text::reject_blank(bytes, path)?;
     // tobj rejects invalid UTF-8 anywhere, even in comments; numbers are ASCII anyway.
     let source = String::from_utf8_lossy(bytes);
+    // The update is needed when another crate in the build enables tobj's optional fields.
+    #[allow(clippy::needless_update)]
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: false,

@@ -50,13 +50,12 @@ pub(crate) struct Header {
 
 /// Parses the header at the start of `bytes`.
 pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Header> {
-    if !bytes.starts_with(b"ply") || !matches!(bytes.get(3), Some(b'\n' | b'\r')) {
-        let message = if bytes.is_empty() {
-            "file is empty"
-        } else {
-            "not a PLY file: it must start with a `ply` line"
-        };
-        return Err(Error::parse(path, "line 1", message));
+    const BAD_MAGIC: &str = "not a PLY file: it must start with a `ply` line";
+    if bytes.is_empty() {
+        return Err(Error::parse(path, "line 1", "file is empty"));
+    }
+    if !bytes.starts_with(b"ply") {
+        return Err(Error::parse(path, "line 1", BAD_MAGIC));
     }
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
@@ -66,7 +65,8 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Header> {
         let fail = |message: String| Error::parse(path, format!("line {number}"), message);
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
-            _ if number == 1 => {}
+            ["ply"] if number == 1 => {}
+            _ if number == 1 => return Err(fail(BAD_MAGIC.into())),
             [] | ["comment", ..] | ["obj_info", ..] => {}
             ["format", format, version] => {
                 if *version != "1.0" && *version != "1" {
@@ -199,8 +199,11 @@ mod tests {
             err.contains("line 2") && err.contains("unknown format"),
             "{err}"
         );
-        let err = parse_str("plx\n").unwrap_err().to_string();
-        assert!(err.contains("not a PLY file"), "{err}");
+        for bad in ["plx\n", "plyx\n", "ply 1\n"] {
+            let err = parse_str(bad).unwrap_err().to_string();
+            assert!(err.contains("line 1: not a PLY file"), "{err}");
+        }
+        assert!(parse_str("ply \r\nformat ascii 1.0\nend_header\n").is_ok());
         assert!(parse_str("ply\nformat ascii 1.0\n").is_err());
     }
 }
