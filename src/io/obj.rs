@@ -1,0 +1,188 @@
+//! Wavefront OBJ through `tobj`, keeping position indexing (no per-corner vertex splitting).
+//!
+//! Polygons are fan-triangulated by tobj; points and lines (`p`, `l`, one- and two-corner
+//! `f`) are ignored. tobj numbers vertices in order of first use by a face and drops the ones
+//! no face uses; a file with no faces is read as a point cloud of all its `v` lines. Normals are
+//! kept only when they are per-vertex: as many normals as positions, indexed like them.
+
+use crate::error::{Error, Result};
+use crate::io::{assemble, text};
+use crate::mesh::Mesh;
+use glam::Vec3;
+use std::io::{self, Write};
+use std::panic::{self, AssertUnwindSafe};
+use std::path::Path;
+
+/// tobj reports no line numbers; errors it finds are located at this.
+const WHOLE_FILE: &str = "OBJ data";
+
+/// Parses a whole OBJ file held in memory. `path` is used only in error messages; material
+/// libraries are not loaded.
+pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    text::reject_blank(bytes, path)?;
+    // tobj rejects invalid UTF-8 anywhere, even in comments; numbers are ASCII anyway.
+    let source = String::from_utf8_lossy(bytes);
+    // The update is needed when another crate in the build enables tobj's optional fields.
+    #[allow(clippy::needless_update)]
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    // tobj can overflow (and so panic, with overflow checks) on absurd relative indices.
+    let loaded = panic::catch_unwind(AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut source.as_bytes(), &options, |_| Ok(Default::default()))
+    }));
+    let models = match loaded {
+        Ok(Ok((models, _materials))) => models,
+        Ok(Err(e)) => return Err(Error::parse(path, WHOLE_FILE, e.to_string())),
+        Err(_) => return Err(Error::parse(path, WHOLE_FILE, "malformed face indices")),
+    };
+    if models.iter().all(|m| m.mesh.indices.is_empty()) {
+        return points(&source, path);
+    }
+    merge(&models, path)
+}
+
+/// Concatenates tobj's models, offsetting each one's indices.
+fn merge(models: &[tobj::Model], path: &Path) -> Result<Mesh> {
+    let mut mesh = Mesh {
+        normals: Some(Vec::new()),
+        ..Mesh::default()
+    };
+    for model in models {
+        let m = &model.mesh;
+        let offset = u32::try_from(mesh.positions.len())
+            .map_err(|_| Error::TooLarge(format!("{}: too many vertices", path.display())))?;
+        for p in m.positions.chunks_exact(3) {
+            let p = Vec3::new(p[0], p[1], p[2]);
+            let vertex = mesh.positions.len();
+            let p = assemble::finite_position(p)
+                .map_err(|e| Error::parse(path, WHOLE_FILE, format!("vertex {vertex} {e}")))?;
+            mesh.positions.push(p);
+        }
+        for t in m.indices.chunks_exact(3) {
+            let shift = |i: u32| {
+                i.checked_add(offset).ok_or_else(|| {
+                    Error::TooLarge(format!("{}: too many vertices", path.display()))
+                })
+            };
+            mesh.triangles
+                .push([shift(t[0])?, shift(t[1])?, shift(t[2])?]);
+        }
+        let per_vertex = m.normals.len() == m.positions.len() && m.normal_indices == m.indices;
+        match &mut mesh.normals {
+            Some(normals) if per_vertex => normals.extend(
+                m.normals
+                    .chunks_exact(3)
+                    .map(|n| Vec3::new(n[0], n[1], n[2])),
+            ),
+            _ => mesh.normals = None,
+        }
+    }
+    Ok(mesh)
+}
+
+/// A file without faces: every `v` line is a point; `vn` lines are its normals when there is
+/// exactly one per point.
+fn points(source: &str, path: &Path) -> Result<Mesh> {
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    for (n, line) in text::lines(source.as_bytes()) {
+        let mut words = line.split_whitespace();
+        let is_position = match words.next() {
+            Some("v") => true,
+            Some("vn") => false,
+            _ => continue,
+        };
+        let at = |m: String| Error::parse(path, format!("line {n}"), m);
+        let mut xyz = [0.0f32; 3];
+        for c in &mut xyz {
+            let word = words
+                .next()
+                .ok_or_else(|| at("expected 3 numbers".into()))?;
+            *c = text::number(word).map_err(at)?;
+        }
+        if is_position {
+            let vertex = positions.len();
+            let p = assemble::finite_position(Vec3::from(xyz))
+                .map_err(|m| at(format!("vertex {vertex} {m}")))?;
+            positions.push(p);
+        } else {
+            normals.push(Vec3::from(xyz));
+        }
+    }
+    let has_normals = !normals.is_empty() && normals.len() == positions.len();
+    Ok(Mesh::from_points(positions, has_normals.then_some(normals)))
+}
+
+/// Writes `mesh` as OBJ with 1-based indices; with normals, faces are `f a//a b//b c//c`.
+pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh) -> io::Result<()> {
+    writeln!(out, "# written by vstree")?;
+    for p in &mesh.positions {
+        writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+    }
+    if let Some(normals) = &mesh.normals {
+        for n in normals {
+            writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
+        }
+    }
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| u64::from(i) + 1);
+        if mesh.normals.is_some() {
+            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
+        } else {
+            writeln!(out, "f {a} {b} {c}")?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse_str(s: &str) -> Result<Mesh> {
+        parse(s.as_bytes(), Path::new("t.obj"))
+    }
+
+    #[test]
+    fn triangulates_and_keeps_per_vertex_normals() {
+        let src = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n\
+                   f 1//1 2//2 3//3 4//4\n";
+        let m = parse_str(src).unwrap();
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(m.normals.as_ref().map(Vec::len), Some(4));
+        // One normal shared by all corners is not per-vertex.
+        let m = parse_str("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n").unwrap();
+        assert!(m.normals.is_none());
+    }
+
+    #[test]
+    fn merges_groups_with_offsets() {
+        let src =
+            "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
+        let m = parse_str(src).unwrap();
+        assert_eq!(m.positions.len(), 6);
+        assert_eq!(m.triangles, vec![[0, 1, 2], [3, 4, 5]]);
+        assert_eq!(m.positions[3], Vec3::Z);
+    }
+
+    #[test]
+    fn points_only_is_a_point_cloud() {
+        let m = parse_str("v 0 0 0\nv 1 0 0\nvn 0 0 1\nvn 0 0 1\n").unwrap();
+        assert!(m.is_point_cloud());
+        assert_eq!(m.positions.len(), 2);
+        assert!(m.normals.is_some());
+    }
+
+    #[test]
+    fn bad_input_is_an_error_not_a_panic() {
+        assert!(parse_str("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").is_err());
+        assert!(parse_str("v 0 x 0\n").is_err());
+        assert!(parse_str("v 0 0 0\nvn 0 0 1\nf 1//-4 1//1 1//1\n").is_err());
+        assert!(parse_str("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").is_err());
+    }
+}

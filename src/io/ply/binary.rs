@@ -1,0 +1,148 @@
+//! The body of a binary PLY file. Elements whose properties are all scalars have a fixed
+//! stride, so they are decoded straight from the byte slice at precomputed offsets; elements
+//! with lists (faces) are read item by item.
+
+use super::header::{Element, Header, Kind};
+use super::items::{self, Cursor, Fail, Parts};
+use super::plan::{Job, Plan, Role, Target};
+use super::scalar::Scalar;
+use crate::error::Result;
+use crate::mesh::Mesh;
+use std::path::Path;
+
+/// Reads the body `bytes` in the given byte order.
+pub(crate) fn read(
+    bytes: &[u8],
+    big_endian: bool,
+    header: &Header,
+    plan: &Plan,
+    path: &Path,
+) -> Result<Mesh> {
+    let mut cursor = Bytes {
+        data: bytes,
+        pos: 0,
+        big_endian,
+    };
+    let mut parts = Parts::new(plan.vertex_count, plan.has_normals);
+    for (element, job) in header.elements.iter().zip(&plan.jobs) {
+        match fixed_layout(element, job) {
+            Some(layout) => read_fixed(&mut cursor, element, &layout, &mut parts, path)?,
+            None => items::read_element(&mut cursor, element, job, &mut parts, path)?,
+        }
+    }
+    Ok(parts.into_mesh())
+}
+
+/// Where to find the used values inside one fixed-size item.
+struct Layout {
+    stride: usize,
+    /// `(byte offset, type, slot in [x, y, z, nx, ny, nz])` of each used property.
+    fields: Vec<(usize, Scalar, usize)>,
+    vertices: bool,
+}
+
+/// The layout of `element` when none of its properties is a list.
+fn fixed_layout(element: &Element, job: &Job) -> Option<Layout> {
+    let mut stride = 0usize;
+    let mut fields = Vec::new();
+    for (property, role) in element.properties.iter().zip(&job.roles) {
+        let Kind::Scalar(ty) = property.kind else {
+            return None;
+        };
+        if let Role::Coord(slot) = *role {
+            fields.push((stride, ty, slot));
+        }
+        stride = stride.checked_add(ty.size())?;
+    }
+    Some(Layout {
+        stride,
+        fields,
+        vertices: job.target == Target::Vertices,
+    })
+}
+
+/// Decodes (or skips) all items of a fixed-size element in one pass over its bytes.
+fn read_fixed(
+    cursor: &mut Bytes,
+    element: &Element,
+    layout: &Layout,
+    parts: &mut Parts,
+    path: &Path,
+) -> Result<()> {
+    if layout.stride == 0 {
+        return Ok(());
+    }
+    let available = cursor.remaining();
+    let block = element
+        .count
+        .checked_mul(layout.stride)
+        .and_then(|size| cursor.take(size));
+    let Some(block) = block else {
+        let item = available / layout.stride;
+        return Err(items::error(path, None, element, item, Fail::End));
+    };
+    if !layout.vertices {
+        return Ok(());
+    }
+    parts.reserve_vertices(element.count);
+    let mut coords = [0.0f32; 6];
+    for (item, bytes) in block.chunks_exact(layout.stride).enumerate() {
+        let mut decoded = Ok(());
+        for &(offset, ty, slot) in &layout.fields {
+            match bytes
+                .get(offset..)
+                .and_then(|b| ty.decode(b, cursor.big_endian))
+            {
+                Some(value) => coords[slot] = value as f32,
+                None => decoded = Err(Fail::End),
+            }
+        }
+        decoded
+            .and_then(|()| parts.push_vertex(coords).map_err(Fail::Bad))
+            .map_err(|fail| items::error(path, None, element, item, fail))?;
+    }
+    Ok(())
+}
+
+/// A position in a binary body.
+struct Bytes<'a> {
+    data: &'a [u8],
+    pos: usize,
+    big_endian: bool,
+}
+
+impl<'a> Bytes<'a> {
+    /// The next `n` bytes, or `None` (without moving) if fewer are left.
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        let end = self.pos.checked_add(n)?;
+        let bytes = self.data.get(self.pos..end)?;
+        self.pos = end;
+        Some(bytes)
+    }
+}
+
+impl Cursor for Bytes<'_> {
+    fn coord(&mut self, ty: Scalar) -> Result<f32, Fail> {
+        self.number(ty).map(|v| v as f32)
+    }
+
+    #[inline]
+    fn number(&mut self, ty: Scalar) -> Result<f64, Fail> {
+        let bytes = self.take(ty.size()).ok_or(Fail::End)?;
+        ty.decode(bytes, self.big_endian).ok_or(Fail::End)
+    }
+
+    fn skip_list(&mut self, count: Scalar, item: Scalar) -> Result<(), Fail> {
+        let n = items::list_length(self.number(count)?)?;
+        let size = n.checked_mul(item.size()).ok_or(Fail::End)?;
+        self.take(size).map(drop).ok_or(Fail::End)
+    }
+
+    fn remaining(&self) -> usize {
+        self.data.len().saturating_sub(self.pos)
+    }
+
+    fn line(&self) -> Option<usize> {
+        None
+    }
+}

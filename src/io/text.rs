@@ -1,0 +1,60 @@
+//! Small helpers shared by the line-oriented text formats (OFF, XYZ, ASCII PLY, OBJ).
+
+use crate::error::Error;
+use std::borrow::Cow;
+use std::path::Path;
+use std::str::FromStr;
+
+/// The lines of `bytes`, numbered from 1, without their `\n` or `\r\n` terminator. Invalid
+/// UTF-8 is replaced (it can only matter inside comments: numbers are ASCII).
+pub(crate) fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, Cow<'_, str>)> {
+    bytes.split(|&b| b == b'\n').enumerate().map(|(i, line)| {
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        (i + 1, String::from_utf8_lossy(line))
+    })
+}
+
+/// Parses one number token, with a message that shows the offending token.
+pub(crate) fn number<T: FromStr>(token: &str) -> Result<T, String> {
+    token
+        .parse()
+        .map_err(|_| format!("expected a number, found {}", quoted(token)))
+}
+
+/// `token` in backquotes, shortened if long, for error messages.
+pub(crate) fn quoted(token: &str) -> String {
+    const MAX: usize = 40;
+    match token.char_indices().nth(MAX) {
+        Some((cut, _)) => format!("`{}...`", &token[..cut]),
+        None => format!("`{token}`"),
+    }
+}
+
+/// The error every reader gives for a file with nothing but whitespace in it.
+pub(crate) fn reject_blank(bytes: &[u8], path: &Path) -> Result<(), Error> {
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        Err(Error::parse(path, "line 1", "file is empty"))
+    } else {
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_lines_and_strips_crlf() {
+        let got: Vec<_> = lines(b"a\r\nb\n\nc").collect();
+        assert_eq!(got.len(), 4);
+        assert_eq!((got[0].0, &*got[0].1), (1, "a"));
+        assert_eq!((got[3].0, &*got[3].1), (4, "c"));
+    }
+
+    #[test]
+    fn number_errors_quote_the_token() {
+        assert_eq!(number::<f32>("1.5"), Ok(1.5));
+        assert!(number::<f32>("abc").unwrap_err().contains("`abc`"));
+        assert!(quoted(&"x".repeat(100)).ends_with("...`"));
+    }
+}

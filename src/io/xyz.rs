@@ -1,0 +1,104 @@
+//! XYZ / PWN point clouds: one point per line, `x y z` or `x y z nx ny nz`, the same number of
+//! columns on every line. Blank lines and lines starting with `#` are skipped.
+
+use crate::error::{Error, Result};
+use crate::io::{assemble, text};
+use crate::mesh::Mesh;
+use glam::Vec3;
+use std::io::{self, Write};
+use std::path::Path;
+
+/// Parses a whole XYZ/PWN file held in memory. `path` is used only in error messages.
+pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    text::reject_blank(bytes, path)?;
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    // Column count and line of the first point, which every other point must match.
+    let mut first: Option<(usize, usize)> = None;
+    let mut values = Vec::with_capacity(6);
+    for (n, line) in text::lines(bytes) {
+        let content = line.trim_start();
+        if content.is_empty() || content.starts_with('#') {
+            continue;
+        }
+        let at = |message: String| Error::parse(path, format!("line {n}"), message);
+        values.clear();
+        for word in content.split_whitespace() {
+            values.push(text::number::<f32>(word).map_err(at)?);
+        }
+        match first {
+            None if values.len() == 3 || values.len() == 6 => first = Some((values.len(), n)),
+            None => {
+                return Err(at(format!(
+                    "expected 3 or 6 numbers (x y z [nx ny nz]), found {}",
+                    values.len()
+                )))
+            }
+            Some((columns, line)) if columns != values.len() => {
+                return Err(at(format!(
+                    "expected {columns} numbers like line {line}, found {}",
+                    values.len()
+                )))
+            }
+            Some(_) => {}
+        }
+        let p = Vec3::new(values[0], values[1], values[2]);
+        let point = positions.len();
+        positions
+            .push(assemble::finite_position(p).map_err(|m| at(format!("point {point}: {m}")))?);
+        if let [_, _, _, nx, ny, nz] = values[..] {
+            normals.push(Vec3::new(nx, ny, nz));
+        }
+    }
+    assemble::vertex_count_fits(positions.len())
+        .map_err(|m| Error::TooLarge(format!("{}: {m}", path.display())))?;
+    let has_normals = first.is_some_and(|(columns, _)| columns == 6);
+    Ok(Mesh::from_points(positions, has_normals.then_some(normals)))
+}
+
+/// Writes the positions (and normals) of `mesh`; triangles are not part of the format.
+pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh) -> io::Result<()> {
+    let normals = mesh.normals.as_deref();
+    for (i, p) in mesh.positions.iter().enumerate() {
+        write!(out, "{} {} {}", p.x, p.y, p.z)?;
+        if let Some(normals) = normals {
+            let n = normals.get(i).copied().unwrap_or(Vec3::ZERO);
+            write!(out, " {} {} {}", n.x, n.y, n.z)?;
+        }
+        writeln!(out)?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse_str(s: &str) -> Result<Mesh> {
+        parse(s.as_bytes(), Path::new("t.xyz"))
+    }
+
+    #[test]
+    fn reads_points_with_and_without_normals() {
+        let m = parse_str("# header\n\n0 0 0\r\n1 2 3\n").unwrap();
+        assert_eq!(m.positions, vec![Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0)]);
+        assert!(m.normals.is_none());
+        let m = parse_str("0 0 0 0 0 1\n").unwrap();
+        assert_eq!(m.normals, Some(vec![Vec3::Z]));
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let err = parse_str("0 0 0 0 0 1\n\n1 1 1\n").unwrap_err().to_string();
+        assert!(
+            err.contains("line 3") && err.contains("like line 1"),
+            "{err}"
+        );
+        let err = parse_str("0 0 0 1\n").unwrap_err().to_string();
+        assert!(err.contains("line 1") && err.contains("3 or 6"), "{err}");
+        let err = parse_str("0 0 0\n0 zero 0\n").unwrap_err().to_string();
+        assert!(err.contains("line 2") && err.contains("`zero`"), "{err}");
+        let err = parse_str("0 0 0\nnan 0 0\n").unwrap_err().to_string();
+        assert!(err.contains("line 2") && err.contains("point 1"), "{err}");
+    }
+}
