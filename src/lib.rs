@@ -8,6 +8,7 @@
 pub mod error;
 pub mod io;
 pub mod mesh;
+pub mod rng;
 pub mod shapes;
 
 pub use error::{Error, Result};
