@@ -10,6 +10,7 @@ pub mod io;
 pub mod mesh;
 pub mod rng;
 pub mod shapes;
+pub mod topology;
 
 pub use error::{Error, Result};
 pub use mesh::{Aabb, Mesh};
