@@ -329,7 +329,7 @@ pub fn implicit_mesh(
     let (lo, hi) = (min.min(max), min.max(max));
     let extent = hi - lo;
     let longest = extent.max_element();
-    if !lo.is_finite() || !hi.is_finite() || !(longest > 0.0) {
+    if !lo.is_finite() || !hi.is_finite() || longest <= 0.0 {
         return Mesh::default();
     }
     let resolution = resolution.clamp(1, MAX_RESOLUTION);
@@ -475,7 +475,7 @@ pub fn implicit_mesh(
         normals: None,
         triangles,
     };
-    if normals.iter().any(|n| *n == Vec3::ZERO) {
+    if normals.contains(&Vec3::ZERO) {
         let fallback = area_weighted_normals(&mesh);
         for (n, alt) in normals.iter_mut().zip(fallback) {
             if *n == Vec3::ZERO {
@@ -555,14 +555,73 @@ fn tetrahedron(
 /// random streams do not depend on the thread count.
 const CHUNK: usize = 1 << 14;
 
+/// Walker's alias table (built by Vose's method) over the triangles with positive area: a draw
+/// costs one random slot and one comparison, whatever the number of triangles.
+struct AliasTable {
+    slots: Vec<AliasSlot>,
+}
+
+/// One slot: keep `own` with probability `keep`, else take `alias`.
+#[derive(Clone, Copy)]
+struct AliasSlot {
+    keep: f64,
+    own: u32,
+    alias: u32,
+}
+
+impl AliasTable {
+    /// The table for choosing `items[i]` with probability `weights[i] / sum`. All weights must
+    /// be positive and finite, and there must be fewer than 2^32 of them.
+    fn new(items: &[u32], weights: &[f64]) -> AliasTable {
+        let n = items.len();
+        let total: f64 = weights.iter().sum();
+        // Scaled so the mean is 1; slots below 1 are topped up from slots above 1.
+        let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
+        let mut slots: Vec<AliasSlot> = items
+            .iter()
+            .map(|&own| AliasSlot {
+                keep: 1.0,
+                own,
+                alias: own,
+            })
+            .collect();
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) =
+            (0..n).partition(|&i| scaled[i] < 1.0);
+        while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
+            slots[s].keep = scaled[s];
+            slots[s].alias = items[l];
+            scaled[l] -= 1.0 - scaled[s];
+            if scaled[l] < 1.0 {
+                large.pop();
+                small.push(l);
+            }
+        }
+        // Whatever is left (only through rounding) keeps itself: keep = 1 already. Every item
+        // has positive weight, so no zero-area triangle can be drawn this way.
+        AliasTable { slots }
+    }
+
+    /// An item drawn from 64 random bits: the high half picks the slot (multiply-shift), the low
+    /// half is the coin.
+    fn draw(&self, bits: u64) -> u32 {
+        let slot = &self.slots[(((bits >> 32) * self.slots.len() as u64) >> 32) as usize];
+        let coin = (bits & 0xFFFF_FFFF) as f64 * (1.0 / 4_294_967_296.0);
+        if coin < slot.keep {
+            slot.own
+        } else {
+            slot.alias
+        }
+    }
+}
+
 /// `count` points distributed uniformly by area on the triangles of `mesh`, as a point cloud
 /// (no triangles) with normals.
 ///
-/// Each point picks a triangle with probability proportional to its area (binary search in a
-/// cumulative-area table), then a uniform point in it (square-root barycentric mapping). Its
-/// normal is the barycentric interpolation of the vertex normals when the mesh has normals (one
-/// per vertex), which for a tessellated smooth surface is closer to the true normal; otherwise,
-/// or where the interpolation vanishes, the triangle's unit normal.
+/// Each point picks a triangle with probability proportional to its area (an alias table, so
+/// the cost per point does not grow with the mesh), then a uniform point in it (square-root
+/// barycentric mapping). Its normal is the barycentric interpolation of the vertex normals when
+/// the mesh has normals (one per vertex), which for a tessellated smooth surface is closer to
+/// the true normal; otherwise, or where the interpolation vanishes, the triangle's unit normal.
 ///
 /// Deterministic for a given `seed` whatever the thread count: the points are generated in
 /// fixed-size chunks, each with its own random stream derived from (seed, chunk index).
@@ -570,24 +629,21 @@ const CHUNK: usize = 1 << 14;
 /// `count == 0`) gives an empty cloud.
 pub fn sample_surface(mesh: &Mesh, count: usize, seed: u64) -> Mesh {
     let p = &mesh.positions;
-    let triangles = &mesh.triangles;
-    let mut cumulative = Vec::with_capacity(triangles.len());
-    let mut total = 0.0f64;
-    for tri in triangles {
-        let double_area = if tri.iter().all(|&v| (v as usize) < p.len()) {
+    let (items, weights): (Vec<u32>, Vec<f64>) = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .filter(|(_, tri)| tri.iter().all(|&v| (v as usize) < p.len()))
+        .map(|(t, tri)| {
             let [a, b, c] = tri.map(|v| p[v as usize].as_dvec3());
-            (b - a).cross(c - a).length()
-        } else {
-            0.0
-        };
-        if double_area.is_finite() {
-            total += double_area;
-        }
-        cumulative.push(total);
-    }
-    if count == 0 || !(total > 0.0) || !total.is_finite() {
+            (t as u32, (b - a).cross(c - a).length())
+        })
+        .filter(|&(_, double_area)| double_area > 0.0 && double_area.is_finite())
+        .unzip();
+    if count == 0 || items.is_empty() {
         return Mesh::from_points(Vec::new(), Some(Vec::new()));
     }
+    let table = AliasTable::new(&items, &weights);
     let vertex_normals = mesh.normals.as_deref().filter(|n| n.len() == p.len());
 
     let mut positions = vec![Vec3::ZERO; count];
@@ -599,13 +655,7 @@ pub fn sample_surface(mesh: &Mesh, count: usize, seed: u64) -> Mesh {
         .for_each(|(chunk, (positions, normals))| {
             let mut rng = Rng::new(stream_seed(seed, chunk as u64));
             for (position, normal) in positions.iter_mut().zip(normals) {
-                let target = rng.f64() * total;
-                // The first triangle whose cumulative area exceeds the target has positive
-                // area, since target < total.
-                let t = cumulative
-                    .partition_point(|&c| c <= target)
-                    .min(triangles.len() - 1);
-                let tri = triangles[t];
+                let tri = mesh.triangles[table.draw(rng.next_u64()) as usize];
                 let [a, b, c] = tri.map(|v| p[v as usize]);
                 let r1 = rng.f32().sqrt();
                 let r2 = rng.f32();
@@ -731,6 +781,25 @@ mod tests {
         );
         let r = analyze(&m);
         assert!(r.is_watertight(), "{r:?}");
+    }
+
+    #[test]
+    fn alias_table_reproduces_the_weights() {
+        let weights = [1.0, 0.0001, 5.0, 2.5, 0.3, 1.2];
+        let items: Vec<u32> = (10..16).collect();
+        let table = AliasTable::new(&items, &weights);
+        let total: f64 = weights.iter().sum();
+        let mut rng = Rng::new(1);
+        let n = 1_000_000;
+        let mut counts = [0usize; 6];
+        for _ in 0..n {
+            counts[(table.draw(rng.next_u64()) - 10) as usize] += 1;
+        }
+        for (c, w) in counts.iter().zip(weights) {
+            let expected = w / total * n as f64;
+            let sd = expected.sqrt().max(1.0);
+            assert!((*c as f64 - expected).abs() < 5.0 * sd, "{counts:?}");
+        }
     }
 
     #[test]
