@@ -78,7 +78,7 @@ pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
 fn closest_point_on_segment(p: Vec3, a: Vec3, b: Vec3) -> Vec3 {
     let ab = b - a;
     let length_squared = ab.length_squared();
-    if !(length_squared > 0.0) {
+    if length_squared <= 0.0 || length_squared.is_nan() {
         return a;
     }
     a + ab * ((p - a).dot(ab) / length_squared).clamp(0.0, 1.0)
@@ -128,9 +128,124 @@ struct Bvh {
     order: Vec<u32>,
 }
 
+/// Subtrees over more items than this build their two halves in parallel. The tree does not
+/// depend on it (nor on the thread count): only who builds which part.
+const PARALLEL_BUILD: usize = 1 << 15;
+
+/// What a build step needs to know about the items.
+struct BuildInput<'a> {
+    boxes: &'a [(Vec3, Vec3)],
+    centroids: &'a [Vec3],
+    leaf_size: usize,
+}
+
+impl BuildInput<'_> {
+    /// The box of `items`, and the longest axis of their centroids' box.
+    fn bounds(&self, items: &[u32]) -> (Vec3, Vec3, usize) {
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let (mut c_lo, mut c_hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for &i in items {
+            let (bmin, bmax) = self.boxes[i as usize];
+            lo = lo.min(bmin);
+            hi = hi.max(bmax);
+            c_lo = c_lo.min(self.centroids[i as usize]);
+            c_hi = c_hi.max(self.centroids[i as usize]);
+        }
+        let extent = c_hi - c_lo;
+        let axis = if extent.x >= extent.y && extent.x >= extent.z {
+            0
+        } else if extent.y >= extent.z {
+            1
+        } else {
+            2
+        };
+        (lo, hi, axis)
+    }
+
+    /// Puts the lower half of `items` (by centroid along `axis`) first; returns the split.
+    fn split(&self, items: &mut [u32], axis: usize) -> usize {
+        let middle = items.len() / 2;
+        items.select_nth_unstable_by(middle, |&a, &b| {
+            self.centroids[a as usize][axis].total_cmp(&self.centroids[b as usize][axis])
+        });
+        middle
+    }
+
+    /// The nodes of the subtree over `items`, which sit at position `offset` of the full order.
+    /// The root comes first and the two children of a node are adjacent. Leaves' `first` is a
+    /// position in the full order; internal nodes' `first` indexes the returned vector.
+    fn subtree(&self, items: &mut [u32], offset: usize) -> Vec<Node> {
+        if items.len() <= PARALLEL_BUILD {
+            return self.sequential_subtree(items, offset);
+        }
+        let (min, max, axis) = self.bounds(items);
+        let middle = self.split(items, axis);
+        let (low, high) = items.split_at_mut(middle);
+        let (left, right) = rayon::join(
+            || self.subtree(low, offset),
+            || self.subtree(high, offset + middle),
+        );
+        // Layout: [root, left root, right root, rest of left, rest of right]. Children indices
+        // inside a subtree are never 0, so they shift by where that subtree's rest now starts.
+        let shift = |node: &Node, by: usize| Node {
+            first: if node.count == 0 {
+                node.first + by as u32
+            } else {
+                node.first
+            },
+            ..*node
+        };
+        let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+        nodes.push(Node {
+            min,
+            max,
+            first: 1,
+            count: 0,
+        });
+        nodes.push(shift(&left[0], 2));
+        nodes.push(shift(&right[0], left.len() + 1));
+        nodes.extend(left[1..].iter().map(|n| shift(n, 2)));
+        nodes.extend(right[1..].iter().map(|n| shift(n, left.len() + 1)));
+        nodes
+    }
+
+    /// [`BuildInput::subtree`] on one thread, with an explicit stack.
+    fn sequential_subtree(&self, items: &mut [u32], offset: usize) -> Vec<Node> {
+        let blank = Node {
+            min: Vec3::ZERO,
+            max: Vec3::ZERO,
+            first: 0,
+            count: 0,
+        };
+        // A median split halves the count, so there are fewer than 4 n / leaf_size nodes.
+        let mut nodes = Vec::with_capacity(4 * items.len() / self.leaf_size + 1);
+        nodes.push(blank);
+        let mut pending = vec![(0usize, 0usize, items.len())];
+        while let Some((node, start, end)) = pending.pop() {
+            let range = &mut items[start..end];
+            let (min, max, axis) = self.bounds(range);
+            nodes[node].min = min;
+            nodes[node].max = max;
+            if range.len() <= self.leaf_size {
+                nodes[node].first = (offset + start) as u32;
+                nodes[node].count = range.len() as u32;
+                continue;
+            }
+            let middle = self.split(range, axis);
+            let left = nodes.len();
+            nodes.extend([blank, blank]);
+            nodes[node].first = left as u32;
+            pending.push((left + 1, start + middle, end));
+            pending.push((left, start, start + middle));
+        }
+        nodes
+    }
+}
+
 impl Bvh {
     /// Builds the hierarchy over items with boxes `boxes[i] = (min, max)`, at most `leaf_size`
-    /// items per leaf.
+    /// items per leaf: top-down, each node split at the median centroid along the longest axis
+    /// of its centroids' box.
     fn build(boxes: &[(Vec3, Vec3)], leaf_size: usize) -> Bvh {
         let n = boxes.len();
         if n == 0 {
@@ -138,58 +253,12 @@ impl Bvh {
         }
         let centroids: Vec<Vec3> = boxes.par_iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
         let mut order: Vec<u32> = (0..n as u32).collect();
-        // A median split halves the count, so there are fewer than 2n / leaf_size * 2 nodes.
-        let mut nodes = Vec::with_capacity(4 * n / leaf_size.max(1) + 1);
-        nodes.push(Node {
-            min: Vec3::ZERO,
-            max: Vec3::ZERO,
-            first: 0,
-            count: 0,
-        });
-        let mut pending = vec![(0usize, 0usize, n)];
-        while let Some((node, start, end)) = pending.pop() {
-            let items = &mut order[start..end];
-            let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-            let (mut c_lo, mut c_hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-            for &i in items.iter() {
-                let (bmin, bmax) = boxes[i as usize];
-                lo = lo.min(bmin);
-                hi = hi.max(bmax);
-                c_lo = c_lo.min(centroids[i as usize]);
-                c_hi = c_hi.max(centroids[i as usize]);
-            }
-            nodes[node].min = lo;
-            nodes[node].max = hi;
-            if items.len() <= leaf_size {
-                nodes[node].first = start as u32;
-                nodes[node].count = items.len() as u32;
-                continue;
-            }
-            let extent = c_hi - c_lo;
-            let axis = if extent.x >= extent.y && extent.x >= extent.z {
-                0
-            } else if extent.y >= extent.z {
-                1
-            } else {
-                2
-            };
-            let middle = items.len() / 2;
-            items.select_nth_unstable_by(middle, |&a, &b| {
-                centroids[a as usize][axis].total_cmp(&centroids[b as usize][axis])
-            });
-            let left = nodes.len();
-            let blank = Node {
-                min: Vec3::ZERO,
-                max: Vec3::ZERO,
-                first: 0,
-                count: 0,
-            };
-            nodes.extend([blank, blank]);
-            nodes[node].first = left as u32;
-            nodes[node].count = 0;
-            pending.push((left + 1, start + middle, end));
-            pending.push((left, start, start + middle));
-        }
+        let input = BuildInput {
+            boxes,
+            centroids: &centroids,
+            leaf_size: leaf_size.max(1),
+        };
+        let nodes = input.subtree(&mut order, 0);
         Bvh { nodes, order }
     }
 
@@ -628,6 +697,61 @@ mod tests {
             let [a, b, c] =
                 mesh.triangles[found.triangle as usize].map(|v| mesh.positions[v as usize]);
             assert!((closest_point_on_triangle(p, a, b, c) - found.point).length() <= 1e-6);
+        }
+    }
+
+    /// Checks the invariants a query relies on: every item in exactly one leaf, leaves no larger
+    /// than `leaf_size`, children's boxes inside their parent's, items' boxes inside their leaf's.
+    fn validate(bvh: &Bvh, boxes: &[(Vec3, Vec3)], leaf_size: usize) {
+        let mut seen = vec![false; boxes.len()];
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let node = bvh.nodes[i];
+            let inside = |lo: Vec3, hi: Vec3| lo.cmpge(node.min).all() && hi.cmple(node.max).all();
+            if node.count > 0 {
+                assert!(node.count as usize <= leaf_size);
+                for position in node.first..node.first + node.count {
+                    let item = bvh.order[position as usize] as usize;
+                    assert!(!seen[item]);
+                    seen[item] = true;
+                    assert!(inside(boxes[item].0, boxes[item].1));
+                }
+            } else {
+                for child in [node.first as usize, node.first as usize + 1] {
+                    assert!(child > i && child < bvh.nodes.len());
+                    assert!(inside(bvh.nodes[child].min, bvh.nodes[child].max));
+                    stack.push(child);
+                }
+            }
+        }
+        assert!(seen.iter().all(|&s| s));
+    }
+
+    #[test]
+    fn parallel_build_is_valid_and_thread_independent() {
+        let mut rng = Rng::new(3);
+        let n = 5 * PARALLEL_BUILD + 123;
+        let boxes: Vec<(Vec3, Vec3)> = (0..n)
+            .map(|_| {
+                let p = random_vec(&mut rng);
+                (p, p + Vec3::splat(rng.f32() * 0.01))
+            })
+            .collect();
+        let build = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| Bvh::build(&boxes, 4))
+        };
+        let (one, two) = (build(1), build(2));
+        validate(&two, &boxes, 4);
+        assert_eq!(one.order, two.order);
+        assert_eq!(format!("{:?}", one.nodes), format!("{:?}", two.nodes));
+        let points: Vec<Vec3> = boxes.iter().map(|b| b.0).collect();
+        let cloud = PointBvh::new(&points);
+        for q in points.iter().step_by(997) {
+            assert_eq!(cloud.distance(*q), 0.0);
         }
     }
 
