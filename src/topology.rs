@@ -231,13 +231,13 @@ pub fn analyze(mesh: &Mesh) -> TopologyReport {
     // Per-component Euler characteristics, components numbered by their first face.
     let mut component_of_root = vec![u32::MAX; faces.len()];
     let mut component_of_face = vec![0u32; faces.len()];
-    for f in 0..faces.len() {
+    for (f, component) in component_of_face.iter_mut().enumerate() {
         let root = components.find(f as u32) as usize;
         if component_of_root[root] == u32::MAX {
             component_of_root[root] = report.components as u32;
             report.components += 1;
         }
-        component_of_face[f] = component_of_root[root];
+        *component = component_of_root[root];
     }
     let mut chi = vec![0i64; report.components];
     for &c in &component_of_face {
