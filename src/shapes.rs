@@ -93,11 +93,15 @@ pub fn icosphere(radius: f32, subdivisions: u32) -> Mesh {
 
 /// A torus around the z axis, centred at the origin: the tube of radius `minor` around the
 /// circle of radius `major` in the xy plane. `major_segments` (around z) and `minor_segments`
-/// (around the tube) are at least 3. Genus 1, exact torus normals.
+/// (around the tube) are clamped to 3..=32768. Genus 1, exact torus normals.
 ///
 /// With `minor >= major` the tube self-intersects; the mesh is still combinatorially a torus.
 pub fn torus(major: f32, minor: f32, major_segments: u32, minor_segments: u32) -> Mesh {
-    let (m, n) = (major_segments.max(3), minor_segments.max(3));
+    // The clamp keeps m * n (the vertex count) within u32.
+    let (m, n) = (
+        major_segments.clamp(3, 1 << 15),
+        minor_segments.clamp(3, 1 << 15),
+    );
     let mut positions = Vec::with_capacity((m * n) as usize);
     let mut normals = Vec::with_capacity((m * n) as usize);
     for i in 0..m {

@@ -1,8 +1,10 @@
 //! Timings of the measurement tools at scale. Ignored by default; run with
 //! `cargo test --release --test shapes_perf -- --ignored --nocapture --test-threads 1`.
 
+use glam::Vec3;
 use std::time::Instant;
 use vstree::distance::{point_to_mesh_distances, point_to_points_distances, PointBvh, TriangleBvh};
+use vstree::rng::Rng;
 use vstree::shapes::{add_noise, genus_n_pretzel, icosphere, sample_surface, torus};
 use vstree::topology::analyze;
 
@@ -39,6 +41,22 @@ fn timings() {
     let d = timed(
         "point_to_mesh_distances 1M queries vs 100k triangles",
         || point_to_mesh_distances(&noisy.positions, &mesh),
+    );
+    assert!(d.iter().all(|x| x.is_finite()));
+    // Queries spread through the bounding box (up to ~1 unit from the surface) prune less.
+    let mut rng = Rng::new(4);
+    let far: Vec<Vec3> = (0..1_000_000)
+        .map(|_| {
+            Vec3::new(
+                rng.f32() * 3.0 - 1.5,
+                rng.f32() * 3.0 - 1.5,
+                rng.f32() - 0.5,
+            )
+        })
+        .collect();
+    let d = timed(
+        "point_to_mesh_distances 1M box-uniform queries vs 100k triangles",
+        || point_to_mesh_distances(&far, &mesh),
     );
     assert!(d.iter().all(|x| x.is_finite()));
 
