@@ -5,15 +5,18 @@
 //! surface's local frame, near it. It gives better-balanced clusters than an octree for
 //! clustering simplification, and drives a fast point-to-mesh reconstruction.
 
+pub mod distance;
 pub mod error;
 pub mod io;
 mod linalg;
 pub mod mesh;
 pub mod progress;
 pub mod quadric;
+pub mod rng;
 pub mod samples;
 pub mod shapes;
 pub mod simplify;
+pub mod topology;
 pub mod tree;
 
 pub use error::{Error, Result};

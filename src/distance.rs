@@ -1,0 +1,817 @@
+//! Point-to-mesh, point-to-point-cloud and mesh-to-mesh distances.
+//!
+//! Two bounding volume hierarchies do the searching: [`TriangleBvh`] (closest point on a set of
+//! triangles, with the exact point-triangle distance) and [`PointBvh`] (nearest point of a
+//! cloud). Both are built top-down, splitting each node's items at the median of their centroids
+//! along the longest axis of the centroids' box, and stored in flat arrays linked by `u32`
+//! indices with the items of each leaf contiguous. A query descends nearer child first and
+//! prunes any box farther than the best distance found so far, so its result is exact.
+//!
+//! Conventions: distances are Euclidean, in the input's units, computed in `f32`. Anything
+//! measured against an empty target (no usable triangles, no points) is `f32::INFINITY`; a query
+//! point with a NaN coordinate gives NaN. Batch functions run in parallel and their output does
+//! not depend on the thread count (each result depends on its own query only).
+
+use crate::mesh::Mesh;
+use crate::rng::stream_seed;
+use crate::shapes::sample_surface;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// The point of triangle (a, b, c) closest to `p`.
+///
+/// Ericson's region method (Real-Time Collision Detection, 5.1.5): the signs of a few dot
+/// products tell which Voronoi region of the triangle (a vertex, an edge, or the face) contains
+/// `p`, and only that feature's projection is computed. Degenerate triangles (zero area, or so
+/// thin that the face formula is unstable) are handled as their three edges.
+pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let ab = b - a;
+    let ac = c - a;
+    let normal = ab.cross(ac);
+    if normal.length_squared()
+        <= f32::EPSILON * f32::EPSILON * ab.length_squared() * ac.length_squared()
+    {
+        return closest_point_on_edges(p, a, b, c);
+    }
+    let ap = p - a;
+    let d1 = ab.dot(ap);
+    let d2 = ac.dot(ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a; // vertex region a
+    }
+    let bp = p - b;
+    let d3 = ab.dot(bp);
+    let d4 = ac.dot(bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return b; // vertex region b
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3)); // edge region ab
+    }
+    let cp = p - c;
+    let d5 = ab.dot(cp);
+    let d6 = ac.dot(cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return c; // vertex region c
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6)); // edge region ac
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return b + (c - b) * w; // edge region bc
+    }
+    // Face region: barycentric coordinates from the three sub-areas.
+    let inverse = 1.0 / (va + vb + vc);
+    let q = a + ab * (vb * inverse) + ac * (vc * inverse);
+    if q.is_finite() {
+        q
+    } else {
+        closest_point_on_edges(p, a, b, c)
+    }
+}
+
+/// The point of segment [a, b] closest to `p` (a when the segment is a point).
+fn closest_point_on_segment(p: Vec3, a: Vec3, b: Vec3) -> Vec3 {
+    let ab = b - a;
+    let length_squared = ab.length_squared();
+    if length_squared <= 0.0 || length_squared.is_nan() {
+        return a;
+    }
+    a + ab * ((p - a).dot(ab) / length_squared).clamp(0.0, 1.0)
+}
+
+/// The closest point on the three edges of a (degenerate) triangle.
+fn closest_point_on_edges(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    [
+        closest_point_on_segment(p, a, b),
+        closest_point_on_segment(p, b, c),
+        closest_point_on_segment(p, c, a),
+    ]
+    .into_iter()
+    .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
+    .unwrap_or(a)
+}
+
+/// A node of a [`Bvh`]: its box, and either a range of items (leaf, `count > 0`) or the index
+/// of the first of its two adjacent children (`count == 0`).
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    min: Vec3,
+    max: Vec3,
+    first: u32,
+    count: u32,
+}
+
+impl Node {
+    /// Squared distance from `p` to the node's box (0 inside).
+    fn distance_squared(&self, p: Vec3) -> f32 {
+        (self.min - p)
+            .max(p - self.max)
+            .max(Vec3::ZERO)
+            .length_squared()
+    }
+}
+
+/// The deepest a median-split tree of up to 2^32 items gets, with margin: the traversal stack
+/// needs at most one entry per level plus one.
+const MAX_STACK: usize = 64;
+
+/// The shape of a bounding volume hierarchy over items given by their boxes; `order[i]` is the
+/// item stored at position `i`, so each leaf covers `order[first..first + count]`.
+#[derive(Clone, Debug, Default)]
+struct Bvh {
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+}
+
+/// Subtrees over more items than this build their two halves in parallel. The tree does not
+/// depend on it (nor on the thread count): only who builds which part.
+const PARALLEL_BUILD: usize = 1 << 15;
+
+/// What a build step needs to know about the items.
+struct BuildInput<'a> {
+    boxes: &'a [(Vec3, Vec3)],
+    centroids: &'a [Vec3],
+    leaf_size: usize,
+}
+
+impl BuildInput<'_> {
+    /// The box of `items`, and the longest axis of their centroids' box.
+    fn bounds(&self, items: &[u32]) -> (Vec3, Vec3, usize) {
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let (mut c_lo, mut c_hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for &i in items {
+            let (bmin, bmax) = self.boxes[i as usize];
+            lo = lo.min(bmin);
+            hi = hi.max(bmax);
+            c_lo = c_lo.min(self.centroids[i as usize]);
+            c_hi = c_hi.max(self.centroids[i as usize]);
+        }
+        let extent = c_hi - c_lo;
+        let axis = if extent.x >= extent.y && extent.x >= extent.z {
+            0
+        } else if extent.y >= extent.z {
+            1
+        } else {
+            2
+        };
+        (lo, hi, axis)
+    }
+
+    /// Puts the lower half of `items` (by centroid along `axis`) first; returns the split.
+    fn split(&self, items: &mut [u32], axis: usize) -> usize {
+        let middle = items.len() / 2;
+        items.select_nth_unstable_by(middle, |&a, &b| {
+            self.centroids[a as usize][axis].total_cmp(&self.centroids[b as usize][axis])
+        });
+        middle
+    }
+
+    /// The nodes of the subtree over `items`, which sit at position `offset` of the full order.
+    /// The root comes first and the two children of a node are adjacent. Leaves' `first` is a
+    /// position in the full order; internal nodes' `first` indexes the returned vector.
+    fn subtree(&self, items: &mut [u32], offset: usize) -> Vec<Node> {
+        if items.len() <= PARALLEL_BUILD {
+            return self.sequential_subtree(items, offset);
+        }
+        let (min, max, axis) = self.bounds(items);
+        let middle = self.split(items, axis);
+        let (low, high) = items.split_at_mut(middle);
+        let (left, right) = rayon::join(
+            || self.subtree(low, offset),
+            || self.subtree(high, offset + middle),
+        );
+        // Layout: [root, left root, right root, rest of left, rest of right]. Children indices
+        // inside a subtree are never 0, so they shift by where that subtree's rest now starts.
+        let shift = |node: &Node, by: usize| Node {
+            first: if node.count == 0 {
+                node.first + by as u32
+            } else {
+                node.first
+            },
+            ..*node
+        };
+        let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+        nodes.push(Node {
+            min,
+            max,
+            first: 1,
+            count: 0,
+        });
+        nodes.push(shift(&left[0], 2));
+        nodes.push(shift(&right[0], left.len() + 1));
+        nodes.extend(left[1..].iter().map(|n| shift(n, 2)));
+        nodes.extend(right[1..].iter().map(|n| shift(n, left.len() + 1)));
+        nodes
+    }
+
+    /// [`BuildInput::subtree`] on one thread, with an explicit stack.
+    fn sequential_subtree(&self, items: &mut [u32], offset: usize) -> Vec<Node> {
+        let blank = Node {
+            min: Vec3::ZERO,
+            max: Vec3::ZERO,
+            first: 0,
+            count: 0,
+        };
+        // A median split halves the count, so there are fewer than 4 n / leaf_size nodes.
+        let mut nodes = Vec::with_capacity(4 * items.len() / self.leaf_size + 1);
+        nodes.push(blank);
+        let mut pending = vec![(0usize, 0usize, items.len())];
+        while let Some((node, start, end)) = pending.pop() {
+            let range = &mut items[start..end];
+            let (min, max, axis) = self.bounds(range);
+            nodes[node].min = min;
+            nodes[node].max = max;
+            if range.len() <= self.leaf_size {
+                nodes[node].first = (offset + start) as u32;
+                nodes[node].count = range.len() as u32;
+                continue;
+            }
+            let middle = self.split(range, axis);
+            let left = nodes.len();
+            nodes.extend([blank, blank]);
+            nodes[node].first = left as u32;
+            pending.push((left + 1, start + middle, end));
+            pending.push((left, start, start + middle));
+        }
+        nodes
+    }
+}
+
+impl Bvh {
+    /// Builds the hierarchy over items with boxes `boxes[i] = (min, max)`, at most `leaf_size`
+    /// items per leaf: top-down, each node split at the median centroid along the longest axis
+    /// of its centroids' box.
+    fn build(boxes: &[(Vec3, Vec3)], leaf_size: usize) -> Bvh {
+        let n = boxes.len();
+        if n == 0 {
+            return Bvh::default();
+        }
+        let centroids: Vec<Vec3> = boxes.par_iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        let input = BuildInput {
+            boxes,
+            centroids: &centroids,
+            leaf_size: leaf_size.max(1),
+        };
+        let nodes = input.subtree(&mut order, 0);
+        Bvh { nodes, order }
+    }
+
+    /// The item minimising `item_distance_squared(position, p)` over positions (indices into
+    /// `order`), with its squared distance; `None` when empty or nothing compares below
+    /// infinity. Ties keep the first found.
+    fn nearest(
+        &self,
+        p: Vec3,
+        item_distance_squared: impl Fn(usize) -> f32,
+    ) -> Option<(usize, f32)> {
+        let root = self.nodes.first()?;
+        let mut best: Option<(usize, f32)> = None;
+        let mut best_d2 = f32::INFINITY;
+        let mut stack = [0u32; MAX_STACK];
+        let mut depth = 0;
+        if root.distance_squared(p) < best_d2 {
+            stack[0] = 0;
+            depth = 1;
+        }
+        while depth > 0 {
+            depth -= 1;
+            let node = &self.nodes[stack[depth] as usize];
+            // The box may have become too far since it was pushed.
+            if node.distance_squared(p) >= best_d2 {
+                continue;
+            }
+            if node.count > 0 {
+                for position in node.first as usize..(node.first + node.count) as usize {
+                    let d2 = item_distance_squared(position);
+                    if d2 < best_d2 {
+                        best_d2 = d2;
+                        best = Some((position, d2));
+                    }
+                }
+                continue;
+            }
+            let (left, right) = (node.first, node.first + 1);
+            let dl = self.nodes[left as usize].distance_squared(p);
+            let dr = self.nodes[right as usize].distance_squared(p);
+            // Push the farther child first so the nearer one is searched first.
+            let (near, d_near, far, d_far) = if dl <= dr {
+                (left, dl, right, dr)
+            } else {
+                (right, dr, left, dl)
+            };
+            if d_far < best_d2 && depth < MAX_STACK {
+                stack[depth] = far;
+                depth += 1;
+            }
+            if d_near < best_d2 && depth < MAX_STACK {
+                stack[depth] = near;
+                depth += 1;
+            }
+        }
+        best
+    }
+}
+
+/// The closest point of a triangle set to a query, as found by [`TriangleBvh::closest_point`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Closest {
+    /// Euclidean distance from the query to `point`.
+    pub distance: f32,
+    /// Index of the triangle in the mesh's `triangles`.
+    pub triangle: u32,
+    /// The closest point on that triangle.
+    pub point: Vec3,
+}
+
+/// A bounding volume hierarchy over a mesh's triangles for closest-point queries.
+///
+/// Triangles with an out-of-range vertex index are left out; zero-area triangles are kept and
+/// measured as segments or points.
+#[derive(Clone, Debug, Default)]
+pub struct TriangleBvh {
+    bvh: Bvh,
+    /// Corner positions per stored position (leaf order).
+    corners: Vec<[Vec3; 3]>,
+    /// Original triangle index per stored position.
+    ids: Vec<u32>,
+}
+
+/// Triangles per leaf: small leaves prune well, and a leaf's corners share cache lines.
+const TRIANGLE_LEAF: usize = 4;
+/// Points per leaf.
+const POINT_LEAF: usize = 8;
+
+impl TriangleBvh {
+    /// Builds the hierarchy over the triangles of `mesh` (none for a point cloud).
+    pub fn new(mesh: &Mesh) -> TriangleBvh {
+        let p = &mesh.positions;
+        let (corners, ids): (Vec<[Vec3; 3]>, Vec<u32>) = mesh
+            .triangles
+            .iter()
+            .enumerate()
+            .filter(|(_, tri)| tri.iter().all(|&v| (v as usize) < p.len()))
+            .map(|(i, tri)| (tri.map(|v| p[v as usize]), i as u32))
+            .unzip();
+        let boxes: Vec<(Vec3, Vec3)> = corners
+            .par_iter()
+            .map(|[a, b, c]| (a.min(*b).min(*c), a.max(*b).max(*c)))
+            .collect();
+        let bvh = Bvh::build(&boxes, TRIANGLE_LEAF);
+        let corners_sorted = bvh.order.iter().map(|&i| corners[i as usize]).collect();
+        let ids_sorted = bvh.order.iter().map(|&i| ids[i as usize]).collect();
+        TriangleBvh {
+            bvh,
+            corners: corners_sorted,
+            ids: ids_sorted,
+        }
+    }
+
+    /// Number of triangles in the hierarchy.
+    pub fn len(&self) -> usize {
+        self.ids.len()
+    }
+
+    /// True when there are no triangles to measure against.
+    pub fn is_empty(&self) -> bool {
+        self.ids.is_empty()
+    }
+
+    /// The closest point to `p` on any triangle, or `None` when there are no triangles or `p`
+    /// has a NaN coordinate.
+    pub fn closest_point(&self, p: Vec3) -> Option<Closest> {
+        let point_of = |position: usize| {
+            let [a, b, c] = self.corners[position];
+            closest_point_on_triangle(p, a, b, c)
+        };
+        let (position, d2) = self
+            .bvh
+            .nearest(p, |position| point_of(position).distance_squared(p))?;
+        Some(Closest {
+            distance: d2.sqrt(),
+            triangle: self.ids[position],
+            point: point_of(position),
+        })
+    }
+
+    /// Distance from `p` to the triangles: `f32::INFINITY` when there are none, NaN when `p` has
+    /// a NaN coordinate.
+    pub fn distance(&self, p: Vec3) -> f32 {
+        match self.closest_point(p) {
+            Some(c) => c.distance,
+            None if p.is_nan() => f32::NAN,
+            None => f32::INFINITY,
+        }
+    }
+}
+
+/// A bounding volume hierarchy over a point cloud for nearest-neighbour queries.
+#[derive(Clone, Debug, Default)]
+pub struct PointBvh {
+    bvh: Bvh,
+    /// Points per stored position (leaf order).
+    points: Vec<Vec3>,
+}
+
+impl PointBvh {
+    /// Builds the hierarchy over `points`.
+    pub fn new(points: &[Vec3]) -> PointBvh {
+        let boxes: Vec<(Vec3, Vec3)> = points.par_iter().map(|&p| (p, p)).collect();
+        let bvh = Bvh::build(&boxes, POINT_LEAF);
+        let sorted = bvh.order.iter().map(|&i| points[i as usize]).collect();
+        PointBvh {
+            bvh,
+            points: sorted,
+        }
+    }
+
+    /// Number of points in the hierarchy.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// True when there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// The nearest point to `p` as (distance, index in the input slice), or `None` when the
+    /// cloud is empty or `p` has a NaN coordinate.
+    pub fn nearest(&self, p: Vec3) -> Option<(f32, u32)> {
+        let (position, d2) = self
+            .bvh
+            .nearest(p, |position| self.points[position].distance_squared(p))?;
+        Some((d2.sqrt(), self.bvh.order[position]))
+    }
+
+    /// Distance from `p` to the nearest point: `f32::INFINITY` for an empty cloud, NaN when `p`
+    /// has a NaN coordinate.
+    pub fn distance(&self, p: Vec3) -> f32 {
+        match self.nearest(p) {
+            Some((d, _)) => d,
+            None if p.is_nan() => f32::NAN,
+            None => f32::INFINITY,
+        }
+    }
+}
+
+/// Distance from each of `points` to the surface of `mesh` (its triangles), in parallel.
+/// `f32::INFINITY` everywhere when the mesh has no usable triangles.
+pub fn point_to_mesh_distances(points: &[Vec3], mesh: &Mesh) -> Vec<f32> {
+    let bvh = TriangleBvh::new(mesh);
+    points.par_iter().map(|&p| bvh.distance(p)).collect()
+}
+
+/// Distance from each of `points` to the nearest point of `cloud`, in parallel.
+/// `f32::INFINITY` everywhere when `cloud` is empty.
+pub fn point_to_points_distances(points: &[Vec3], cloud: &[Vec3]) -> Vec<f32> {
+    let bvh = PointBvh::new(cloud);
+    points.par_iter().map(|&p| bvh.distance(p)).collect()
+}
+
+/// Summary of a set of distances.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DistanceStats {
+    /// How many distances were summarised; all other fields are 0 when this is 0.
+    pub count: usize,
+    /// Arithmetic mean.
+    pub mean: f32,
+    /// Root mean square.
+    pub rms: f32,
+    /// Largest value.
+    pub max: f32,
+    /// 99th percentile by the nearest-rank method: the smallest value that at least 99% of the
+    /// values do not exceed.
+    pub p99: f32,
+}
+
+impl DistanceStats {
+    /// Summarises `distances` (sums in double precision, in order, so the result is
+    /// deterministic). Empty input gives all zeros with `count == 0`.
+    pub fn from_distances(distances: &[f32]) -> DistanceStats {
+        let count = distances.len();
+        if count == 0 {
+            return DistanceStats::default();
+        }
+        let (mut sum, mut sum_squares, mut max) = (0.0f64, 0.0f64, f32::NEG_INFINITY);
+        for &d in distances {
+            let d64 = f64::from(d);
+            sum += d64;
+            sum_squares += d64 * d64;
+            max = max.max(d);
+        }
+        let rank = (count * 99).div_ceil(100).max(1) - 1;
+        let mut scratch = distances.to_vec();
+        let (_, p99, _) = scratch.select_nth_unstable_by(rank, f32::total_cmp);
+        DistanceStats {
+            count,
+            mean: (sum / count as f64) as f32,
+            rms: (sum_squares / count as f64).sqrt() as f32,
+            max,
+            p99: *p99,
+        }
+    }
+}
+
+/// What distances are measured to: a mesh's triangles, or a set of points.
+#[derive(Clone, Copy, Debug)]
+pub enum Target<'a> {
+    /// The surface of the mesh's triangles.
+    Triangles(&'a Mesh),
+    /// The nearest of these points.
+    Points(&'a [Vec3]),
+}
+
+impl<'a> Target<'a> {
+    /// The triangles of `mesh` when it has any, else its points.
+    pub fn of(mesh: &'a Mesh) -> Target<'a> {
+        if mesh.triangles.is_empty() {
+            Target::Points(&mesh.positions)
+        } else {
+            Target::Triangles(mesh)
+        }
+    }
+
+    /// Distance from each of `points` to this target, in parallel.
+    pub fn distances(&self, points: &[Vec3]) -> Vec<f32> {
+        match *self {
+            Target::Triangles(mesh) => point_to_mesh_distances(points, mesh),
+            Target::Points(cloud) => point_to_points_distances(points, cloud),
+        }
+    }
+}
+
+/// Statistics of the distances from each of `from` to `to` (one-sided).
+pub fn one_sided(from: &[Vec3], to: Target) -> DistanceStats {
+    DistanceStats::from_distances(&to.distances(from))
+}
+
+/// The points that stand for `mesh` in a two-sided comparison: `samples` points sampled
+/// uniformly by area on its triangles, or all its points when it is a point cloud.
+fn representative_points(mesh: &Mesh, samples: usize, seed: u64) -> Vec<Vec3> {
+    if mesh.triangles.is_empty() {
+        mesh.positions.clone()
+    } else {
+        sample_surface(mesh, samples, seed).positions
+    }
+}
+
+/// One-sided statistics in both directions: (a to b, b to a).
+///
+/// Each side is represented by `samples_per_mesh` points sampled uniformly by area on its
+/// surface (seeded from `seed`; the two sides use different streams) or, for a point cloud, by
+/// all its points. Those points are measured to the other side's triangles, or to its points
+/// when it is a cloud. A side with no representative points (empty, or zero area) gives
+/// `count == 0` statistics in its direction, and measuring to it gives infinite distances.
+pub fn two_sided(
+    a: &Mesh,
+    b: &Mesh,
+    samples_per_mesh: usize,
+    seed: u64,
+) -> (DistanceStats, DistanceStats) {
+    let from_a = representative_points(a, samples_per_mesh, stream_seed(seed, 0));
+    let from_b = representative_points(b, samples_per_mesh, stream_seed(seed, 1));
+    (
+        one_sided(&from_a, Target::of(b)),
+        one_sided(&from_b, Target::of(a)),
+    )
+}
+
+/// The symmetric Chamfer and Hausdorff distances between `a` and `b`, from [`two_sided`]:
+/// chamfer = (mean(a to b) + mean(b to a)) / 2, the mean of the two one-sided mean distances
+/// (not squared); hausdorff = max(max(a to b), max(b to a)), estimated on the samples. Both are 0
+/// when neither side has points, and infinite when exactly one side is empty.
+pub fn chamfer_and_hausdorff(a: &Mesh, b: &Mesh, samples_per_mesh: usize, seed: u64) -> (f32, f32) {
+    let (ab, ba) = two_sided(a, b, samples_per_mesh, seed);
+    (0.5 * (ab.mean + ba.mean), ab.max.max(ba.max))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+    use glam::DVec3;
+
+    /// Independent oracle: project onto the plane in double precision; if the projection is
+    /// inside (barycentric test) that is the answer, else the nearest of the three edges.
+    fn oracle_distance(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f64 {
+        let (p, a, b, c) = (p.as_dvec3(), a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+        let segment = |a: DVec3, b: DVec3| {
+            let ab = b - a;
+            let t = if ab.length_squared() > 0.0 {
+                ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (a + ab * t).distance(p)
+        };
+        let edges = segment(a, b).min(segment(b, c)).min(segment(c, a));
+        let n = (b - a).cross(c - a);
+        if n.length_squared() == 0.0 {
+            return edges;
+        }
+        let q = p - n * ((p - a).dot(n) / n.length_squared());
+        let inside = [(a, b), (b, c), (c, a)]
+            .iter()
+            .all(|&(u, v)| (v - u).cross(q - u).dot(n) >= 0.0);
+        if inside {
+            q.distance(p)
+        } else {
+            edges
+        }
+    }
+
+    fn random_vec(rng: &mut Rng) -> Vec3 {
+        Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 2.0 - Vec3::ONE
+    }
+
+    #[test]
+    fn point_triangle_matches_oracle() {
+        let mut rng = Rng::new(11);
+        for _ in 0..20_000 {
+            let (a, b, c) = (
+                random_vec(&mut rng),
+                random_vec(&mut rng),
+                random_vec(&mut rng),
+            );
+            let p = random_vec(&mut rng) * 2.0;
+            let got = f64::from(closest_point_on_triangle(p, a, b, c).distance(p));
+            let want = oracle_distance(p, a, b, c);
+            assert!(
+                (got - want).abs() < 1e-5,
+                "{p} {a} {b} {c}: {got} vs {want}"
+            );
+        }
+        // Degenerate triangles: a point, a segment, collinear corners.
+        let p = Vec3::new(0.3, 1.0, 0.0);
+        let z = Vec3::ZERO;
+        assert_eq!(closest_point_on_triangle(p, z, z, z), z);
+        let q = closest_point_on_triangle(p, z, Vec3::X, Vec3::X);
+        assert!((q - Vec3::new(0.3, 0.0, 0.0)).length() < 1e-6);
+        let q = closest_point_on_triangle(p, z, Vec3::X * 0.5, Vec3::X);
+        assert!((q - Vec3::new(0.3, 0.0, 0.0)).length() < 1e-6);
+    }
+
+    /// A small random triangle soup.
+    fn soup(rng: &mut Rng, n: usize) -> Mesh {
+        let mut mesh = Mesh::default();
+        for t in 0..n as u32 {
+            let centre = random_vec(rng);
+            for _ in 0..3 {
+                mesh.positions.push(centre + random_vec(rng) * 0.2);
+            }
+            mesh.triangles.push([3 * t, 3 * t + 1, 3 * t + 2]);
+        }
+        mesh
+    }
+
+    #[test]
+    fn triangle_bvh_matches_brute_force() {
+        let mut rng = Rng::new(5);
+        let mesh = soup(&mut rng, 300);
+        let bvh = TriangleBvh::new(&mesh);
+        assert_eq!(bvh.len(), 300);
+        for _ in 0..3_000 {
+            let p = random_vec(&mut rng) * 1.5;
+            let brute = mesh
+                .triangles
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+                    closest_point_on_triangle(p, a, b, c)
+                        .distance_squared(p)
+                        .sqrt()
+                })
+                .fold(f32::INFINITY, f32::min);
+            let found = bvh.closest_point(p).unwrap();
+            assert!(
+                (found.distance - brute).abs() <= 1e-6,
+                "{} vs {brute}",
+                found.distance
+            );
+            let [a, b, c] =
+                mesh.triangles[found.triangle as usize].map(|v| mesh.positions[v as usize]);
+            assert!((closest_point_on_triangle(p, a, b, c) - found.point).length() <= 1e-6);
+        }
+    }
+
+    /// Checks the invariants a query relies on: every item in exactly one leaf, leaves no larger
+    /// than `leaf_size`, children's boxes inside their parent's, items' boxes inside their leaf's.
+    fn validate(bvh: &Bvh, boxes: &[(Vec3, Vec3)], leaf_size: usize) {
+        let mut seen = vec![false; boxes.len()];
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let node = bvh.nodes[i];
+            let inside = |lo: Vec3, hi: Vec3| lo.cmpge(node.min).all() && hi.cmple(node.max).all();
+            if node.count > 0 {
+                assert!(node.count as usize <= leaf_size);
+                for position in node.first..node.first + node.count {
+                    let item = bvh.order[position as usize] as usize;
+                    assert!(!seen[item]);
+                    seen[item] = true;
+                    assert!(inside(boxes[item].0, boxes[item].1));
+                }
+            } else {
+                for child in [node.first as usize, node.first as usize + 1] {
+                    assert!(child > i && child < bvh.nodes.len());
+                    assert!(inside(bvh.nodes[child].min, bvh.nodes[child].max));
+                    stack.push(child);
+                }
+            }
+        }
+        assert!(seen.iter().all(|&s| s));
+    }
+
+    #[test]
+    fn parallel_build_is_valid_and_thread_independent() {
+        let mut rng = Rng::new(3);
+        let n = 5 * PARALLEL_BUILD + 123;
+        let boxes: Vec<(Vec3, Vec3)> = (0..n)
+            .map(|_| {
+                let p = random_vec(&mut rng);
+                (p, p + Vec3::splat(rng.f32() * 0.01))
+            })
+            .collect();
+        let build = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| Bvh::build(&boxes, 4))
+        };
+        let (one, two) = (build(1), build(2));
+        validate(&two, &boxes, 4);
+        assert_eq!(one.order, two.order);
+        assert_eq!(format!("{:?}", one.nodes), format!("{:?}", two.nodes));
+        let points: Vec<Vec3> = boxes.iter().map(|b| b.0).collect();
+        let cloud = PointBvh::new(&points);
+        for q in points.iter().step_by(997) {
+            assert_eq!(cloud.distance(*q), 0.0);
+        }
+    }
+
+    #[test]
+    fn point_bvh_matches_brute_force() {
+        let mut rng = Rng::new(9);
+        let cloud: Vec<Vec3> = (0..2_000).map(|_| random_vec(&mut rng)).collect();
+        let queries: Vec<Vec3> = (0..2_000).map(|_| random_vec(&mut rng) * 1.2).collect();
+        let bvh = PointBvh::new(&cloud);
+        let fast = point_to_points_distances(&queries, &cloud);
+        for (q, d) in queries.iter().zip(&fast) {
+            let (brute_index, brute) = cloud
+                .iter()
+                .enumerate()
+                .map(|(i, c)| (i, c.distance(*q)))
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .unwrap();
+            assert!((d - brute).abs() <= 1e-6);
+            let (d2, index) = bvh.nearest(*q).unwrap();
+            assert_eq!(d2, *d);
+            assert!(
+                (cloud[index as usize].distance(*q) - brute).abs() <= 1e-6,
+                "{brute_index}"
+            );
+        }
+    }
+
+    #[test]
+    fn empty_targets_and_stats() {
+        let p = [Vec3::ONE];
+        assert_eq!(
+            point_to_mesh_distances(&p, &Mesh::default()),
+            vec![f32::INFINITY]
+        );
+        assert_eq!(point_to_points_distances(&p, &[]), vec![f32::INFINITY]);
+        assert!(TriangleBvh::new(&Mesh::default())
+            .closest_point(Vec3::ZERO)
+            .is_none());
+        let mut bad = Mesh::from_points(vec![Vec3::ZERO], None);
+        bad.triangles.push([0, 1, 2]);
+        assert!(TriangleBvh::new(&bad).is_empty());
+        assert!(PointBvh::new(&[Vec3::ZERO]).distance(Vec3::NAN).is_nan());
+
+        assert_eq!(DistanceStats::from_distances(&[]), DistanceStats::default());
+        let values: Vec<f32> = (1..=200).map(|i| i as f32).collect();
+        let s = DistanceStats::from_distances(&values);
+        assert_eq!((s.count, s.max, s.p99), (200, 200.0, 198.0));
+        assert!((s.mean - 100.5).abs() < 1e-4);
+        let s = DistanceStats::from_distances(&[3.0]);
+        assert_eq!((s.mean, s.rms, s.max, s.p99), (3.0, 3.0, 3.0, 3.0));
+
+        let cloud = Mesh::from_points(vec![Vec3::ZERO, Vec3::X * 10.0], None);
+        assert_eq!(
+            chamfer_and_hausdorff(&Mesh::default(), &Mesh::default(), 10, 1),
+            (0.0, 0.0)
+        );
+        let (c, h) = chamfer_and_hausdorff(&cloud, &Mesh::default(), 10, 1);
+        assert!(c.is_infinite() && h.is_infinite());
+        let shifted = Mesh::from_points(vec![Vec3::Y, Vec3::X * 10.0 + Vec3::Y * 3.0], None);
+        let (c, h) = chamfer_and_hausdorff(&cloud, &shifted, 10, 1);
+        assert!((c - 2.0).abs() < 1e-6 && (h - 3.0).abs() < 1e-6, "{c} {h}");
+    }
+}

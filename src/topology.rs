@@ -1,0 +1,433 @@
+//! Topology figures of a triangle mesh: counts, manifoldness, orientation, components, Euler
+//! characteristic and genus, so that tests can assert that a surface is watertight and has the
+//! expected genus (and fail when it is not).
+//!
+//! Everything here is combinatorial except [`signed_volume`] and [`surface_area`]. The edge
+//! analysis sorts the 3F half-edges by their undirected key, so a million triangles take a
+//! fraction of a second.
+
+use crate::mesh::Mesh;
+use rayon::prelude::*;
+
+/// Topological figures of a mesh, as computed by [`analyze`].
+///
+/// Faces with a repeated vertex index or an index out of range are *degenerate*: they are counted
+/// in `degenerate_faces` and ignored by every other figure.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct TopologyReport {
+    /// Vertices referenced by at least one non-degenerate face.
+    pub vertices: usize,
+    /// Vertices in `positions` that no non-degenerate face references.
+    pub unreferenced_vertices: usize,
+    /// Distinct undirected edges.
+    pub edges: usize,
+    /// Non-degenerate faces.
+    pub faces: usize,
+    /// Edges used by exactly one face.
+    pub boundary_edges: usize,
+    /// Edges shared by more than two faces.
+    pub non_manifold_edges: usize,
+    /// Vertices whose incident faces do not form a single disk (closed fan) or half-disk (open
+    /// fan), e.g. two cones touching at their tips, or a vertex on a non-manifold edge.
+    pub non_manifold_vertices: usize,
+    /// Edges shared by exactly two faces that traverse them in the same direction (one of the two
+    /// faces is flipped relative to the other).
+    pub inconsistently_oriented_edges: usize,
+    /// Connected components, where faces sharing an edge are connected.
+    pub components: usize,
+    /// V - E + F over the whole mesh (referenced vertices, distinct edges, non-degenerate faces).
+    pub euler_characteristic: i64,
+    /// Euler characteristic of each component, in the order of each component's first face. A
+    /// vertex shared by several components (a non-manifold vertex) counts in the first one only,
+    /// so these sum to `euler_characteristic`.
+    pub component_euler_characteristics: Vec<i64>,
+    /// Faces with a repeated vertex index or an index out of range.
+    pub degenerate_faces: usize,
+}
+
+impl TopologyReport {
+    /// True for a closed, oriented 2-manifold: at least one face, no degenerate faces, no boundary
+    /// edges, no non-manifold edges or vertices, and every edge traversed once in each direction.
+    pub fn is_watertight(&self) -> bool {
+        self.faces > 0
+            && self.degenerate_faces == 0
+            && self.boundary_edges == 0
+            && self.non_manifold_edges == 0
+            && self.non_manifold_vertices == 0
+            && self.inconsistently_oriented_edges == 0
+    }
+
+    /// The genus (number of handles, summed over components) of a watertight mesh:
+    /// the sum over components c of (2 - chi_c) / 2. `None` when the mesh is not watertight (the
+    /// genus of a surface with boundary or singularities is not what tests mean by "genus").
+    pub fn genus(&self) -> Option<u32> {
+        if !self.is_watertight() {
+            return None;
+        }
+        let mut total = 0u32;
+        for &chi in &self.component_euler_characteristics {
+            // A closed orientable surface has chi = 2 - 2g <= 2, even.
+            if chi > 2 || (2 - chi) % 2 != 0 {
+                return None;
+            }
+            total = total.checked_add(u32::try_from((2 - chi) / 2).ok()?)?;
+        }
+        Some(total)
+    }
+}
+
+/// Disjoint-set forest over `0..n` with path halving and union by size.
+struct UnionFind {
+    parent: Vec<u32>,
+    size: Vec<u32>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> UnionFind {
+        UnionFind {
+            parent: (0..n as u32).collect(),
+            size: vec![1; n],
+        }
+    }
+
+    fn find(&mut self, mut x: u32) -> u32 {
+        while self.parent[x as usize] != x {
+            let grand = self.parent[self.parent[x as usize] as usize];
+            self.parent[x as usize] = grand;
+            x = grand;
+        }
+        x
+    }
+
+    fn union(&mut self, a: u32, b: u32) {
+        let (mut a, mut b) = (self.find(a), self.find(b));
+        if a == b {
+            return;
+        }
+        if self.size[a as usize] < self.size[b as usize] {
+            std::mem::swap(&mut a, &mut b);
+        }
+        self.parent[b as usize] = a;
+        self.size[a as usize] += self.size[b as usize];
+    }
+}
+
+/// True when `tri` has three distinct indices below `vertex_count`.
+fn is_valid_face(tri: &[u32; 3], vertex_count: usize) -> bool {
+    tri.iter().all(|&v| (v as usize) < vertex_count)
+        && tri[0] != tri[1]
+        && tri[1] != tri[2]
+        && tri[0] != tri[2]
+}
+
+/// One directed half-edge: the undirected key (low index in the high 32 bits), and the face index
+/// shifted left by one with the low bit set when the face traverses the edge from high to low.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct HalfEdge {
+    key: u64,
+    face_and_direction: u64,
+}
+
+/// The half-edges of the given faces, sorted by undirected key (then face), so the faces of each
+/// edge are consecutive.
+fn sorted_half_edges(faces: &[[u32; 3]]) -> Vec<HalfEdge> {
+    let mut half_edges: Vec<HalfEdge> = faces
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(f, tri)| {
+            (0..3).map(move |k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let (lo, hi, reversed) = if a < b { (a, b, 0) } else { (b, a, 1) };
+                HalfEdge {
+                    key: (u64::from(lo) << 32) | u64::from(hi),
+                    face_and_direction: ((f as u64) << 1) | reversed,
+                }
+            })
+        })
+        .collect();
+    half_edges.par_sort_unstable();
+    half_edges
+}
+
+/// Computes the [`TopologyReport`] of `mesh`. Point clouds (no triangles) give a report with zero
+/// faces. Never panics on bad indices: such faces count as degenerate.
+pub fn analyze(mesh: &Mesh) -> TopologyReport {
+    let n_vertices = mesh.positions.len();
+    // From here on faces are numbered by their rank among the valid faces.
+    let faces: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .filter(|tri| is_valid_face(tri, n_vertices))
+        .copied()
+        .collect();
+    let degenerate_faces = mesh.triangles.len() - faces.len();
+    let half_edges = sorted_half_edges(&faces);
+
+    let mut report = TopologyReport {
+        faces: faces.len(),
+        degenerate_faces,
+        ..TopologyReport::default()
+    };
+    let mut components = UnionFind::new(faces.len());
+    // The first half-edge of every undirected edge, for counting edges per component.
+    let mut edge_first_faces: Vec<u32> = Vec::new();
+    // Endpoints of non-manifold edges: their vertices are non-manifold too.
+    let mut on_non_manifold_edge = vec![false; n_vertices];
+    for run in half_edges.chunk_by(|a, b| a.key == b.key) {
+        report.edges += 1;
+        let first_face = (run[0].face_and_direction >> 1) as u32;
+        edge_first_faces.push(first_face);
+        for h in &run[1..] {
+            components.union(first_face, (h.face_and_direction >> 1) as u32);
+        }
+        match run.len() {
+            1 => report.boundary_edges += 1,
+            2 => {
+                if (run[0].face_and_direction & 1) == (run[1].face_and_direction & 1) {
+                    report.inconsistently_oriented_edges += 1;
+                }
+            }
+            _ => {
+                report.non_manifold_edges += 1;
+                on_non_manifold_edge[(run[0].key >> 32) as usize] = true;
+                on_non_manifold_edge[(run[0].key & 0xFFFF_FFFF) as usize] = true;
+            }
+        }
+    }
+
+    // Incident faces per vertex (compressed rows), for fans and per-component vertex counts.
+    let mut row_start = vec![0u32; n_vertices + 1];
+    for tri in &faces {
+        for &v in tri {
+            row_start[v as usize + 1] += 1;
+        }
+    }
+    for v in 0..n_vertices {
+        row_start[v + 1] += row_start[v];
+    }
+    let mut fill = row_start.clone();
+    let mut incident = vec![0u32; faces.len() * 3];
+    for (f, tri) in faces.iter().enumerate() {
+        for &v in tri {
+            incident[fill[v as usize] as usize] = f as u32;
+            fill[v as usize] += 1;
+        }
+    }
+
+    report.vertices = (0..n_vertices)
+        .filter(|&v| row_start[v + 1] > row_start[v])
+        .count();
+    report.unreferenced_vertices = n_vertices - report.vertices;
+    report.non_manifold_vertices = (0..n_vertices)
+        .into_par_iter()
+        .filter(|&v| {
+            let fan = &incident[row_start[v] as usize..row_start[v + 1] as usize];
+            !fan.is_empty() && (on_non_manifold_edge[v] || !is_single_fan(v as u32, fan, &faces))
+        })
+        .count();
+    report.euler_characteristic =
+        report.vertices as i64 - report.edges as i64 + report.faces as i64;
+
+    // Per-component Euler characteristics, components numbered by their first face.
+    let mut component_of_root = vec![u32::MAX; faces.len()];
+    let mut component_of_face = vec![0u32; faces.len()];
+    for (f, component) in component_of_face.iter_mut().enumerate() {
+        let root = components.find(f as u32) as usize;
+        if component_of_root[root] == u32::MAX {
+            component_of_root[root] = report.components as u32;
+            report.components += 1;
+        }
+        *component = component_of_root[root];
+    }
+    let mut chi = vec![0i64; report.components];
+    for &c in &component_of_face {
+        chi[c as usize] += 1;
+    }
+    for &f in &edge_first_faces {
+        chi[component_of_face[f as usize] as usize] -= 1;
+    }
+    for v in 0..n_vertices {
+        if row_start[v + 1] > row_start[v] {
+            let f = incident[row_start[v] as usize];
+            chi[component_of_face[f as usize] as usize] += 1;
+        }
+    }
+    report.component_euler_characteristics = chi;
+    report
+}
+
+/// True when the faces `fan` around vertex `v` form one disk or half-disk: in the *link* of `v`
+/// (each face contributes the edge between its two other vertices) every vertex has degree at
+/// most 2 and the link is connected, so it is a single cycle or a single path.
+fn is_single_fan(v: u32, fan: &[u32], faces: &[[u32; 3]]) -> bool {
+    let link_edges: Vec<(u32, u32)> = fan
+        .iter()
+        .map(|&f| {
+            let tri = faces[f as usize];
+            let k = tri.iter().position(|&x| x == v).unwrap_or(0);
+            (tri[(k + 1) % 3], tri[(k + 2) % 3])
+        })
+        .collect();
+    let mut link_vertices: Vec<u32> = link_edges.iter().flat_map(|&(a, b)| [a, b]).collect();
+    link_vertices.sort_unstable();
+    link_vertices.dedup();
+    let local = |x: u32| link_vertices.binary_search(&x).unwrap_or(0) as u32;
+    let mut degree = vec![0u32; link_vertices.len()];
+    let mut uf = UnionFind::new(link_vertices.len());
+    for &(a, b) in &link_edges {
+        let (a, b) = (local(a), local(b));
+        degree[a as usize] += 1;
+        degree[b as usize] += 1;
+        uf.union(a, b);
+    }
+    let root = uf.find(0);
+    degree.iter().all(|&d| d <= 2) && (1..link_vertices.len() as u32).all(|x| uf.find(x) == root)
+}
+
+/// The valence (number of distinct neighbours along edges) of every vertex in `positions`;
+/// unreferenced vertices have valence 0. Degenerate faces are ignored.
+pub fn valences(mesh: &Mesh) -> Vec<u32> {
+    let faces: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .filter(|tri| is_valid_face(tri, mesh.positions.len()))
+        .copied()
+        .collect();
+    let mut valence = vec![0u32; mesh.positions.len()];
+    for run in sorted_half_edges(&faces).chunk_by(|a, b| a.key == b.key) {
+        valence[(run[0].key >> 32) as usize] += 1;
+        valence[(run[0].key & 0xFFFF_FFFF) as usize] += 1;
+    }
+    valence
+}
+
+/// `histogram[k]` = the number of referenced vertices with valence k (unreferenced vertices, of
+/// valence 0, are not counted). Empty for a mesh without faces.
+pub fn valence_histogram(mesh: &Mesh) -> Vec<u32> {
+    let mut histogram: Vec<u32> = Vec::new();
+    for v in valences(mesh).into_iter().filter(|&v| v > 0) {
+        if histogram.len() <= v as usize {
+            histogram.resize(v as usize + 1, 0);
+        }
+        histogram[v as usize] += 1;
+    }
+    histogram
+}
+
+/// The signed volume enclosed by the triangles (sum of the signed tetrahedra from the origin), in
+/// double precision. Positive for a closed mesh with outward (counter-clockwise seen from
+/// outside) winding. Faces with out-of-range indices are skipped.
+pub fn signed_volume(mesh: &Mesh) -> f64 {
+    let p = &mesh.positions;
+    mesh.triangles
+        .iter()
+        .filter(|tri| tri.iter().all(|&v| (v as usize) < p.len()))
+        .map(|&[a, b, c]| {
+            let (a, b, c) = (
+                p[a as usize].as_dvec3(),
+                p[b as usize].as_dvec3(),
+                p[c as usize].as_dvec3(),
+            );
+            a.dot(b.cross(c))
+        })
+        .sum::<f64>()
+        / 6.0
+}
+
+/// The total area of the triangles, in double precision. Faces with out-of-range indices are
+/// skipped.
+pub fn surface_area(mesh: &Mesh) -> f64 {
+    let p = &mesh.positions;
+    mesh.triangles
+        .iter()
+        .filter(|tri| tri.iter().all(|&v| (v as usize) < p.len()))
+        .map(|&[a, b, c]| {
+            let a = p[a as usize].as_dvec3();
+            (p[b as usize].as_dvec3() - a)
+                .cross(p[c as usize].as_dvec3() - a)
+                .length()
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// A unit tetrahedron with outward winding.
+    fn tetrahedron() -> Mesh {
+        Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
+            normals: None,
+            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        }
+    }
+
+    #[test]
+    fn tetrahedron_is_a_sphere() {
+        let m = tetrahedron();
+        let r = analyze(&m);
+        assert_eq!((r.vertices, r.edges, r.faces), (4, 6, 4));
+        assert_eq!(r.euler_characteristic, 2);
+        assert!(r.is_watertight(), "{r:?}");
+        assert_eq!(r.genus(), Some(0));
+        assert!((signed_volume(&m) - 1.0 / 6.0).abs() < 1e-12);
+        assert_eq!(valences(&m), vec![3, 3, 3, 3]);
+        assert_eq!(valence_histogram(&m), vec![0, 0, 0, 4]);
+    }
+
+    #[test]
+    fn defects_are_counted() {
+        let mut open = tetrahedron();
+        open.triangles.pop();
+        let r = analyze(&open);
+        assert_eq!(r.boundary_edges, 3);
+        assert!(!r.is_watertight());
+        assert_eq!(r.genus(), None);
+
+        let mut flipped = tetrahedron();
+        flipped.triangles[0].swap(1, 2);
+        let r = analyze(&flipped);
+        assert_eq!(r.inconsistently_oriented_edges, 3);
+        assert_eq!(r.boundary_edges, 0);
+
+        let mut bad = tetrahedron();
+        bad.triangles.push([0, 0, 1]);
+        bad.triangles.push([0, 1, 99]);
+        let r = analyze(&bad);
+        assert_eq!(r.degenerate_faces, 2);
+        assert_eq!(r.faces, 4);
+        assert!(!r.is_watertight());
+    }
+
+    #[test]
+    fn two_tetrahedra_sharing_a_vertex_are_non_manifold_there() {
+        let mut m = tetrahedron();
+        m.positions.extend([-Vec3::X, -Vec3::Y, -Vec3::Z]);
+        // A second tetrahedron (0, 4, 5, 6), mirrored so its winding is outward too.
+        m.triangles
+            .extend([[0, 4, 5], [0, 6, 4], [0, 5, 6], [4, 6, 5]]);
+        let r = analyze(&m);
+        assert_eq!(r.non_manifold_vertices, 1);
+        assert_eq!(r.non_manifold_edges, 0);
+        assert_eq!(r.components, 2);
+        // The shared vertex counts once, in the component of its first face.
+        assert_eq!(r.component_euler_characteristics, vec![2, 1]);
+        assert_eq!(r.euler_characteristic, 3);
+        assert!(!r.is_watertight());
+    }
+
+    #[test]
+    fn empty_and_point_cloud() {
+        let r = analyze(&Mesh::default());
+        assert_eq!(r, TopologyReport::default());
+        assert!(!r.is_watertight());
+        let cloud = Mesh::from_points(vec![Vec3::ONE; 3], None);
+        let r = analyze(&cloud);
+        assert_eq!((r.faces, r.unreferenced_vertices), (0, 3));
+        assert_eq!(signed_volume(&cloud), 0.0);
+        assert!(valence_histogram(&cloud).is_empty());
+    }
+}
