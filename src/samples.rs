@@ -33,8 +33,8 @@ impl SampleSet {
         self.positions.is_empty()
     }
 
-    /// Samples of a mesh (triangles required) as `sampling` says. Vertices used by no triangle,
-    /// and faces with zero area, give no sample.
+    /// Samples of a mesh (triangles required) as `sampling` says. Only triangles with non-zero
+    /// area count: vertices used by no such triangle, and zero-area faces, give no sample.
     pub fn from_mesh(mesh: &Mesh, sampling: MeshSampling) -> Result<SampleSet> {
         mesh.check()?;
         if mesh.triangles.is_empty() {
@@ -85,8 +85,15 @@ fn area_normal(mesh: &Mesh, tri: &[u32; 3]) -> Vec3 {
 fn vertex_samples(mesh: &Mesh) -> SampleSet {
     let mut sums = vec![Vec3::ZERO; mesh.positions.len()];
     let mut used = vec![false; mesh.positions.len()];
-    for tri in &mesh.triangles {
+    for tri in mesh
+        .triangles
+        .iter()
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+    {
         let n = area_normal(mesh, tri);
+        if n == Vec3::ZERO {
+            continue; // zero area: no orientation, no sample
+        }
         for &i in tri {
             sums[i as usize] += n;
             used[i as usize] = true;
@@ -96,8 +103,8 @@ fn vertex_samples(mesh: &Mesh) -> SampleSet {
     for (i, (&p, sum)) in mesh.positions.iter().zip(&sums).enumerate() {
         if used[i] {
             samples.positions.push(p);
-            // A vertex whose faces are all degenerate keeps a zero normal: it still belongs to
-            // a cluster but adds nothing to the quadric.
+            // Opposite faces can still cancel out (a folded sheet): such a vertex keeps a zero
+            // normal, belongs to a cluster, and adds nothing to the quadric.
             samples.normals.push(sum.normalize_or_zero());
             samples.origin.push(i as u32);
         }

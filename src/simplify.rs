@@ -75,35 +75,19 @@ pub fn cluster(tree: &VsTree, threads: &Threads) -> Clustering {
     }
 }
 
-/// The quadric minimiser of a leaf's samples, clamped into the leaf's cell (a cube for V- and
-/// T-leaves; for S-leaves the square in the frame's plane, and the samples' height range
-/// across it), and the leaf's mean normal.
+/// A leaf's representative (see [`tree::representative`]) and its mean normal.
 fn representative(tree: &VsTree, leaf: usize, origin: DVec3) -> (Vec3, Vec3) {
     let node = &tree.nodes[leaf];
-    let samples = tree.samples_of(node);
     let mut stats = CellStats::default();
-    for s in samples {
+    for s in tree.samples_of(node) {
         stats.add(s.position.as_dvec3() - origin, s.normal.as_dvec3());
     }
-    let x = (stats.quadric_minimizer() + origin).as_vec3();
-    let normal = stats.mean_normal().normalize_or_zero().as_vec3();
-    let clamped = match node.kind {
-        NodeKind::Volume | NodeKind::Transition => {
-            x.clamp(node.center - node.half, node.center + node.half)
-        }
-        NodeKind::Surface => {
-            let f = &tree.frames[node.frame as usize];
-            let (lo, hi) = samples
-                .iter()
-                .map(|s| f.height(s.position))
-                .fold((f32::MAX, f32::MIN), |(lo, hi), h| (lo.min(h), hi.max(h)));
-            let uv = f
-                .project(x)
-                .clamp(node.center_uv() - node.half, node.center_uv() + node.half);
-            f.point(uv, f.height(x).clamp(lo, hi))
-        }
-    };
-    (clamped, normal)
+    let frame = (node.kind == NodeKind::Surface).then(|| &tree.frames[node.frame as usize]);
+    let x = tree::representative(node, frame, &stats, origin);
+    (
+        x.as_vec3(),
+        stats.mean_normal().normalize_or_zero().as_vec3(),
+    )
 }
 
 /// Simplifies `mesh` (or a point cloud with normals) by clustering in the tree `params`

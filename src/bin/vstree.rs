@@ -1,1 +1,284 @@
-fn main() {}
+//! `vstree`: the command-line front end. Reads a mesh or point cloud, runs the library, writes
+//! the result, and says what it did.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+use vstree::simplify::{simplify, SimplifyParams, SimplifyStats};
+use vstree::tree::{Metric, TreeKind, TreeParams, TreeStats};
+use vstree::{io, MeshSampling, Progress, SampleSet, Threads};
+
+#[derive(Parser)]
+#[command(
+    name = "vstree",
+    version,
+    about = "Volume-Surface Trees: clustering simplification and surface reconstruction"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+#[command(args_conflicts_with_subcommands = false)]
+enum Command {
+    /// Simplify a mesh (or a point cloud with normals) by clustering in a VS-Tree.
+    ///
+    /// Every leaf of the tree becomes one output vertex, placed where it best fits the samples'
+    /// tangent planes; triangles are re-indexed, and those that collapse are dropped.
+    Simplify {
+        /// Input file: .ply, .obj, .off, .xyz or .pwn.
+        input: PathBuf,
+        /// Output file (format from the extension). Written atomically: never left half-done.
+        output: PathBuf,
+        #[command(flatten)]
+        tree: TreeArgs,
+        /// Which mesh elements become samples.
+        #[arg(long, value_enum, default_value_t = Sampling::Vertices)]
+        sampling: Sampling,
+        /// Write PLY as text instead of binary.
+        #[arg(long)]
+        ascii: bool,
+    },
+    /// Build the tree and print its statistics, without writing anything.
+    Stats {
+        /// Input file: .ply, .obj, .off, .xyz or .pwn.
+        input: PathBuf,
+        #[command(flatten)]
+        tree: TreeArgs,
+        /// Also build the other kind of tree (octree or VS-Tree) and compare cluster counts.
+        #[arg(long)]
+        compare: bool,
+    },
+}
+
+#[derive(Args, Clone)]
+struct TreeArgs {
+    /// Hierarchy: the VS-Tree, or a plain octree (the baseline).
+    #[arg(long, value_enum, default_value_t = Kind::Vstree)]
+    tree: Kind,
+    /// Error metric that decides when a cell is split.
+    #[arg(long, value_enum, default_value_t = MetricArg::L2)]
+    metric: MetricArg,
+    /// Error bound per cluster. L2: sum of squared sample-plane distances over the squared
+    /// bounding-box diagonal (every sample then lies within sqrt(error) x diagonal of its
+    /// cluster's point); l21: mean squared normal deviation (0-4); density: samples per cluster.
+    /// Larger = coarser output.
+    #[arg(long, default_value_t = 2e-3, allow_negative_numbers = true)]
+    error: f64,
+    /// Normal-cone threshold of the height-field test, in [0, 1]: a cell becomes a surface
+    /// (2D) node only if every normal's dot product with the mean normal exceeds it. Raise it
+    /// for more adaptivity in curved areas.
+    #[arg(long, default_value_t = 0.0)]
+    da: f32,
+    /// Displacement threshold of the height-field test, in [0, 1]: a cell's height range over
+    /// its radius must stay below it. Lower it for more adaptivity in curved areas.
+    #[arg(long, default_value_t = 1.0 / 6.0)]
+    dd: f32,
+    /// Deepest tree level (1-30).
+    #[arg(long, default_value_t = 24)]
+    max_depth: u32,
+    /// Worker threads (0 = all cores).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Kind {
+    Vstree,
+    Octree,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum MetricArg {
+    L2,
+    L21,
+    Density,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Sampling {
+    /// One sample per vertex (normal: area-weighted face normals).
+    Vertices,
+    /// One sample per face, at its centre.
+    Faces,
+}
+
+impl TreeArgs {
+    fn params(&self) -> TreeParams {
+        TreeParams {
+            kind: match self.tree {
+                Kind::Vstree => TreeKind::VsTree,
+                Kind::Octree => TreeKind::Octree,
+            },
+            metric: match self.metric {
+                MetricArg::L2 => Metric::L2,
+                MetricArg::L21 => Metric::L21,
+                MetricArg::Density => Metric::Density,
+            },
+            error: self.error,
+            d_a: self.da,
+            d_d: self.dd,
+            max_depth: self.max_depth,
+            ..TreeParams::default()
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("vstree: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(command: Command) -> vstree::Result<()> {
+    match command {
+        Command::Simplify {
+            input,
+            output,
+            tree,
+            sampling,
+            ascii,
+        } => {
+            tree.params().check()?; // before reading what may be a large file
+            let (mesh, read_s) = timed(|| io::read(&input))?;
+            let params = SimplifyParams {
+                tree: tree.params(),
+                sampling: match sampling {
+                    Sampling::Vertices => MeshSampling::Vertices,
+                    Sampling::Faces => MeshSampling::FaceCenters,
+                },
+                threads: tree.threads,
+            };
+            let (out, stats) =
+                with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
+            let (_, write_s) =
+                timed(|| io::write_with(&output, &out, &io::WriteOptions { ascii }))?;
+            if !tree.quiet {
+                print_simplify(&input, &output, &stats, read_s, write_s);
+            }
+            Ok(())
+        }
+        Command::Stats {
+            input,
+            tree,
+            compare,
+        } => {
+            tree.params().check()?;
+            let mesh = io::read(&input)?;
+            let samples = if mesh.is_point_cloud() {
+                SampleSet::from_cloud(&mesh)?
+            } else {
+                SampleSet::from_mesh(&mesh, MeshSampling::Vertices)?
+            };
+            let threads = Threads::new(tree.threads)?;
+            let mut kinds = vec![tree.params()];
+            if compare {
+                let other = if kinds[0].kind == TreeKind::VsTree {
+                    TreeKind::Octree
+                } else {
+                    TreeKind::VsTree
+                };
+                kinds.push(TreeParams {
+                    kind: other,
+                    ..kinds[0]
+                });
+            }
+            println!("{}: {} samples", input.display(), samples.len());
+            let mut leaves = Vec::new();
+            for params in kinds {
+                let (built, seconds) = timed(|| {
+                    with_progress(tree.quiet, |progress| {
+                        vstree::tree::build(&samples, &params, &threads, progress)
+                    })
+                })?;
+                let stats = built.stats();
+                println!("{:?}: built in {:.3} s", params.kind, seconds);
+                print_tree(&stats);
+                leaves.push(stats.leaves);
+            }
+            if let [first, second] = leaves[..] {
+                println!(
+                    "clusters: {first} vs {second} ({:+.1}%)",
+                    100.0 * (first as f64 / second as f64 - 1.0)
+                );
+            }
+            Ok(())
+        }
+    }
+}
+
+fn timed<T>(f: impl FnOnce() -> vstree::Result<T>) -> vstree::Result<(T, f64)> {
+    let start = Instant::now();
+    let value = f()?;
+    Ok((value, start.elapsed().as_secs_f64()))
+}
+
+/// Runs `f` with a progress bar on stderr (drawn only when stderr is a terminal).
+fn with_progress<T>(
+    quiet: bool,
+    f: impl FnOnce(&mut Progress) -> vstree::Result<T>,
+) -> vstree::Result<T> {
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(1000)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} {msg:20} [{bar:40}] {percent:>3}% {elapsed}")
+            .expect("static template"),
+    );
+    let mut callback = |fraction: f32, stage: &str| {
+        bar.set_message(stage.to_string());
+        bar.set_position((fraction * 1000.0) as u64);
+        true
+    };
+    let result = f(&mut Progress::new(&mut callback));
+    bar.finish_and_clear();
+    result
+}
+
+fn print_tree(s: &TreeStats) {
+    println!(
+        "  nodes: {} (V {}, T {}, S {}), depth {}",
+        s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.max_depth
+    );
+    if s.t_nodes > 0 {
+        println!("  T-layer depth: {}..{}", s.t_depth_min, s.t_depth_max);
+    }
+    println!(
+        "  clusters (leaves): {}, samples per cluster: mean {:.1}, variance {:.1}",
+        s.leaves, s.leaf_size_mean, s.leaf_size_variance
+    );
+}
+
+fn print_simplify(input: &Path, output: &Path, s: &SimplifyStats, read_s: f64, write_s: f64) {
+    println!(
+        "{}: {} vertices, {} triangles",
+        input.display(),
+        s.input_vertices,
+        s.input_triangles
+    );
+    println!("samples: {}", s.tree.samples);
+    print_tree(&s.tree);
+    println!(
+        "{}: {} vertices, {} triangles",
+        output.display(),
+        s.output_vertices,
+        s.output_triangles
+    );
+    println!(
+        "time: read {:.3} s, samples {:.3} s, tree {:.3} s, clustering {:.3} s, write {:.3} s",
+        read_s, s.seconds_samples, s.seconds_tree, s.seconds_cluster, write_s
+    );
+}

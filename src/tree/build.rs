@@ -10,7 +10,10 @@
 
 use super::indicator::{frame, is_height_field};
 use super::partition::partition;
-use super::{Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
+use super::{
+    representative, Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree,
+    NO_FRAME,
+};
 use crate::error::{Error, Result};
 use crate::mesh::Aabb;
 use crate::progress::{Progress, Threads};
@@ -263,7 +266,11 @@ impl Builder {
     ) -> Vec<Pending> {
         let node = part.nodes[i];
         let small_enough = match self.params.metric {
-            Metric::L2 => stats.l2_error() <= self.abs_error,
+            Metric::L2 => {
+                let frame = (node.kind == NodeKind::Surface).then(|| part.frame(node.frame));
+                let x = representative(&node, frame, stats, self.origin);
+                stats.quadric_at(x - self.origin) <= self.abs_error
+            }
             Metric::L21 => stats.normal_deviation() <= self.params.error,
             Metric::Density => stats.count as f64 <= self.params.error,
         };

@@ -12,7 +12,8 @@ mod partition;
 mod validate;
 
 use crate::error::{Error, Result};
-use glam::{Vec2, Vec3};
+use crate::quadric::CellStats;
+use glam::{DVec3, Vec2, Vec3};
 
 pub use build::build;
 
@@ -155,6 +156,40 @@ pub struct Node {
     pub child_count: u8,
     /// Which octant (bits x, y, z) or quadrant (bits u, v) of the parent this node is.
     pub slot: u8,
+}
+
+/// The representative point of a node's samples (their sums `stats`, positions relative to
+/// `origin`): the quadric minimiser, clamped into the node's cell, i.e. its cube for V- and
+/// T-nodes, and for S-nodes (`frame` given) the prism over its square. The tree's L2 test and
+/// the simplification's output vertex both use this point, so the bound holds for the vertex.
+/// Returned in absolute coordinates.
+pub fn representative(
+    node: &Node,
+    frame: Option<&Frame>,
+    stats: &CellStats,
+    origin: DVec3,
+) -> DVec3 {
+    let x = stats.quadric_minimizer() + origin;
+    match (node.kind, frame) {
+        (NodeKind::Surface, Some(f)) => {
+            let (o, u, v, n) = (
+                f.origin.as_dvec3(),
+                f.u.as_dvec3(),
+                f.v.as_dvec3(),
+                f.normal.as_dvec3(),
+            );
+            let d = x - o;
+            let (lo, hi) = (
+                (node.center_uv() - node.half).as_dvec2(),
+                (node.center_uv() + node.half).as_dvec2(),
+            );
+            o + u * d.dot(u).clamp(lo.x, hi.x) + v * d.dot(v).clamp(lo.y, hi.y) + n * d.dot(n)
+        }
+        _ => {
+            let (c, h) = (node.center.as_dvec3(), f64::from(node.half));
+            x.clamp(c - h, c + h)
+        }
+    }
 }
 
 /// `Node::frame` of a V-node.

@@ -1,0 +1,223 @@
+//! Every bad input gets a clear error (or a correct trivial result), never a panic.
+
+use glam::Vec3;
+use vstree::simplify::{simplify, SimplifyParams};
+use vstree::tree::{Metric, TreeParams};
+use vstree::{Error, Mesh, Progress};
+
+fn simplify_with(mesh: &Mesh, tree: TreeParams) -> vstree::Result<(Mesh, vstree::SimplifyStats)> {
+    simplify(
+        mesh,
+        &SimplifyParams {
+            tree,
+            ..Default::default()
+        },
+        &mut Progress::none(),
+    )
+}
+
+fn simplify_default(mesh: &Mesh) -> vstree::Result<(Mesh, vstree::SimplifyStats)> {
+    simplify_with(mesh, TreeParams::default())
+}
+
+fn cloud(points: &[Vec3]) -> Mesh {
+    Mesh::from_points(points.to_vec(), Some(vec![Vec3::Z; points.len()]))
+}
+
+fn message(result: vstree::Result<(Mesh, vstree::SimplifyStats)>) -> String {
+    result.expect_err("expected an error").to_string()
+}
+
+#[test]
+fn empty_inputs_are_refused() {
+    assert!(message(simplify_default(&Mesh::default())).contains("no"));
+    assert!(message(simplify_default(&cloud(&[]))).contains("no samples"));
+}
+
+#[test]
+fn one_two_three_samples_give_trivial_results() {
+    for n in 1..=3 {
+        let points: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect();
+        let (out, stats) = simplify_default(&cloud(&points)).unwrap();
+        assert!(!out.positions.is_empty() && out.positions.len() <= n);
+        assert_eq!(stats.tree.samples, n);
+    }
+    let triangle = Mesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        normals: None,
+        triangles: vec![[0, 1, 2]],
+    };
+    let (out, _) = simplify_default(&triangle).unwrap();
+    assert!(out.triangles.len() <= 1);
+}
+
+#[test]
+fn coplanar_and_identical_points_work() {
+    let plane: Vec<Vec3> = (0..400)
+        .map(|i| Vec3::new((i % 20) as f32, (i / 20) as f32, 0.0))
+        .collect();
+    let (out, stats) = simplify_default(&cloud(&plane)).unwrap();
+    assert_eq!(stats.tree.leaves, 1, "a plane is one cluster");
+    assert_eq!(out.positions.len(), 1);
+    let same = cloud(&[Vec3::splat(3.0); 50]);
+    let (out, _) = simplify_default(&same).unwrap();
+    assert_eq!(out.positions, vec![Vec3::splat(3.0)]);
+    // Identical points with disagreeing normals cannot be split apart: the depth and cell-size
+    // guards stop the recursion.
+    let mut spiky = same.clone();
+    spiky.normals = Some(
+        (0..50)
+            .map(|i| if i % 2 == 0 { Vec3::Z } else { Vec3::X })
+            .collect(),
+    );
+    let (out, _) = simplify_default(&spiky).unwrap();
+    assert_eq!(out.positions.len(), 1);
+}
+
+#[test]
+fn non_finite_values_are_refused_by_index() {
+    let mut bad = cloud(&[Vec3::ZERO, Vec3::X, Vec3::new(f32::NAN, 0.0, 0.0)]);
+    assert!(message(simplify_default(&bad)).contains("vertex 2"));
+    bad.positions[2] = Vec3::new(0.0, f32::INFINITY, 0.0);
+    assert!(message(simplify_default(&bad)).contains("vertex 2"));
+    let mut bad_normal = cloud(&[Vec3::ZERO, Vec3::X]);
+    bad_normal.normals.as_mut().unwrap()[1] = Vec3::NAN;
+    assert!(message(simplify_default(&bad_normal)).contains("normal 1"));
+}
+
+#[test]
+fn zero_normals_in_a_cloud_are_refused() {
+    let mut c = cloud(&[Vec3::ZERO, Vec3::X]);
+    c.normals.as_mut().unwrap()[0] = Vec3::ZERO;
+    assert!(message(simplify_default(&c)).contains("point 0"));
+    let no_normals = Mesh::from_points(vec![Vec3::ZERO, Vec3::X], None);
+    assert!(message(simplify_default(&no_normals)).contains("normals"));
+}
+
+#[test]
+fn out_of_range_indices_are_refused() {
+    let mesh = Mesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        normals: None,
+        triangles: vec![[0, 1, 7]],
+    };
+    let m = message(simplify_default(&mesh));
+    assert!(m.contains("triangle 0") && m.contains('7'), "{m}");
+}
+
+#[test]
+fn degenerate_triangles_are_ignored() {
+    let mesh = Mesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(2.0, 0.0, 0.0)],
+        normals: None,
+        triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
+    };
+    simplify_default(&mesh).unwrap();
+    let all_degenerate = Mesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        normals: None,
+        triangles: vec![[0, 0, 1]],
+    };
+    assert!(message(simplify_default(&all_degenerate)).contains("degenerate"));
+}
+
+#[test]
+fn absurd_parameters_are_refused_by_name() {
+    let mesh = cloud(&[Vec3::ZERO, Vec3::X]);
+    let cases: Vec<(TreeParams, &str)> = vec![
+        (
+            TreeParams {
+                error: 0.0,
+                ..Default::default()
+            },
+            "error",
+        ),
+        (
+            TreeParams {
+                error: -1.0,
+                ..Default::default()
+            },
+            "error",
+        ),
+        (
+            TreeParams {
+                error: f64::NAN,
+                ..Default::default()
+            },
+            "error",
+        ),
+        (
+            TreeParams {
+                error: f64::INFINITY,
+                ..Default::default()
+            },
+            "error",
+        ),
+        (
+            TreeParams {
+                metric: Metric::Density,
+                error: 0.5,
+                ..Default::default()
+            },
+            "error",
+        ),
+        (
+            TreeParams {
+                d_a: 1.5,
+                ..Default::default()
+            },
+            "d_a",
+        ),
+        (
+            TreeParams {
+                d_d: f32::NAN,
+                ..Default::default()
+            },
+            "d_d",
+        ),
+        (
+            TreeParams {
+                max_depth: 0,
+                ..Default::default()
+            },
+            "max_depth",
+        ),
+        (
+            TreeParams {
+                max_depth: 99,
+                ..Default::default()
+            },
+            "max_depth",
+        ),
+        (
+            TreeParams {
+                min_cell_size: -1.0,
+                ..Default::default()
+            },
+            "min_cell_size",
+        ),
+    ];
+    for (params, name) in cases {
+        match simplify_with(&mesh, params) {
+            Err(Error::InvalidParameter { name: got, .. }) => assert_eq!(got, name),
+            other => panic!("{params:?}: expected an error naming {name}, got {other:?}"),
+        }
+    }
+    let absurd_threads = SimplifyParams {
+        threads: 1 << 20,
+        ..Default::default()
+    };
+    assert!(simplify(&mesh, &absurd_threads, &mut Progress::none()).is_err());
+}
+
+#[test]
+fn cancelling_stops_with_cancelled() {
+    let mesh = vstree::shapes::icosphere(1.0, 5);
+    let mut stop = |_: f32, _: &str| false;
+    let result = simplify(
+        &mesh,
+        &SimplifyParams::default(),
+        &mut Progress::new(&mut stop),
+    );
+    assert!(matches!(result, Err(Error::Cancelled)));
+}

@@ -1,0 +1,50 @@
+//! Shared helpers for the integration tests: the real models in `../shared/data` (skipped with
+//! a message when absent) and the samples of a mesh or cloud.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use vstree::{Mesh, MeshSampling, SampleSet};
+
+/// `../shared/data`, or `None` (after saying so) when it is not there.
+pub fn data_dir() -> Option<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("skipping: ../shared/data not found");
+        None
+    }
+}
+
+/// Loads `../shared/data/<name>`, or `None` when the folder is absent.
+pub fn load(name: &str) -> Option<Mesh> {
+    let path = data_dir()?.join(name);
+    Some(vstree::io::read(&path).unwrap_or_else(|e| panic!("{name}: {e}")))
+}
+
+/// Every model in `../shared/data` (empty when the folder is absent).
+pub fn all_models() -> Vec<(String, Mesh)> {
+    let Some(dir) = data_dir() else {
+        return Vec::new();
+    };
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| vstree::io::Format::from_path(n.as_ref()).is_some())
+        .collect();
+    names.sort();
+    names
+        .into_iter()
+        .map(|n| (n.clone(), load(&n).unwrap()))
+        .collect()
+}
+
+/// The samples the library would use: mesh vertices, or the cloud's points when it has normals.
+pub fn samples_of(mesh: &Mesh) -> Option<SampleSet> {
+    if mesh.is_point_cloud() {
+        mesh.normals.as_ref()?;
+        Some(SampleSet::from_cloud(mesh).unwrap())
+    } else {
+        Some(SampleSet::from_mesh(mesh, MeshSampling::Vertices).unwrap())
+    }
+}
