@@ -6,6 +6,7 @@
 //! of threads.
 
 use crate::mesh::Mesh;
+use crate::polygonize;
 use crate::rng::{stream_seed, Rng};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -236,34 +237,6 @@ pub fn genus_n_pretzel(n: u32) -> Mesh {
     implicit_mesh(f, -max, max, resolution)
 }
 
-/// The tetrahedra of the Kuhn (Freudenthal) split of a cube: one per axis permutation, each the
-/// path from corner 0 to corner 7 along the permuted axes. Corners are numbered by bits
-/// (x = 1, y = 2, z = 4). Along each path the corners only gain bits, so every tet edge runs from
-/// a corner to a componentwise-greater one; all cubes split their faces along the same
-/// diagonals, so neighbouring cubes agree. The bool is true for an odd permutation, whose tet
-/// is negatively oriented.
-const KUHN_TETS: [([u8; 4], bool); 6] = [
-    ([0, 1, 3, 7], false), // x, y, z
-    ([0, 2, 6, 7], false), // y, z, x
-    ([0, 4, 5, 7], false), // z, x, y
-    ([0, 1, 5, 7], true),  // x, z, y
-    ([0, 2, 3, 7], true),  // y, x, z
-    ([0, 4, 6, 7], true),  // z, y, x
-];
-
-/// Parity of a permutation of 0..4 (true when odd), by counting inversions.
-fn is_odd_permutation(p: [usize; 4]) -> bool {
-    let mut inversions = 0;
-    for i in 0..4 {
-        for j in i + 1..4 {
-            if p[i] > p[j] {
-                inversions += 1;
-            }
-        }
-    }
-    inversions % 2 == 1
-}
-
 /// The sampled grid of [`implicit_mesh`]: values at the points and, per point, the crossing
 /// edges that start there and the index of the first vertex on them.
 struct Grid {
@@ -305,10 +278,6 @@ impl Grid {
         self.first_vertex[p] + (self.crossings[p] & below).count_ones()
     }
 }
-
-/// Interpolation parameters closer than this to a grid point are pushed away from it, so no
-/// two vertices coincide (a value exactly 0 at a grid point counts as slightly positive).
-const MIN_EDGE_FRACTION: f32 = 1e-3;
 
 /// Polygonises the zero set of `f` (negative inside, positive outside) in the box
 /// `[min, max]` by marching tetrahedra.
@@ -401,9 +370,7 @@ pub fn implicit_mesh(
                             continue;
                         }
                         bits |= 1 << (d - 1);
-                        let t = fp / (fp - fq);
-                        let t = if t.is_finite() { t } else { 0.5 };
-                        let t = t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION);
+                        let t = polygonize::crossing_fraction(fp, fq);
                         let a = grid_ref.point(i, j, k);
                         let b = grid_ref.point(i + di, j + dj, k + dk);
                         positions.push(a + (b - a) * t);
@@ -443,17 +410,14 @@ pub fn implicit_mesh(
                     if inside.iter().all(|&x| x == inside[0]) {
                         continue;
                     }
-                    for (corners, odd_tet) in KUHN_TETS {
-                        tetrahedron(
-                            grid,
-                            positions_ref,
-                            base,
-                            corners,
-                            odd_tet,
-                            &inside,
-                            &mut triangles,
-                        );
-                    }
+                    polygonize::cube_triangles(
+                        &inside,
+                        |lower, upper| {
+                            let v = grid.vertex(base + grid.corner_offset(lower), upper ^ lower);
+                            (v, positions_ref[v as usize])
+                        },
+                        &mut triangles,
+                    );
                 }
             }
             triangles
@@ -489,70 +453,6 @@ pub fn implicit_mesh(
     }
     mesh.normals = Some(normals);
     mesh
-}
-
-/// Emits the outward triangles of one tetrahedron of the cell whose corner 0 is grid point
-/// `base`. `corners` are the tet's cube corners (bits x = 1, y = 2, z = 4), each containing the
-/// previous one; `odd_tet` is true when the tet is negatively oriented.
-///
-/// For a positively oriented tet (v0, v1, v2, v3), the triangle through the edges v0-v1, v0-v2,
-/// v0-v3 (in that order) faces away from v0. Relabelling the tet by an odd permutation flips
-/// that, so every case reduces to "write the vertices in a fixed order, flip when the
-/// permutation's parity and the tet's orientation disagree".
-#[allow(clippy::too_many_arguments)]
-fn tetrahedron(
-    grid: &Grid,
-    positions: &[Vec3],
-    base: usize,
-    corners: [u8; 4],
-    odd_tet: bool,
-    inside: &[bool; 8],
-    out: &mut Vec<[u32; 3]>,
-) {
-    let is_in: [bool; 4] = corners.map(|c| inside[c as usize]);
-    // The vertex on the edge between tet corners x and y.
-    let edge = |x: usize, y: usize| {
-        let (lower, upper) = (corners[x.min(y)], corners[x.max(y)]);
-        grid.vertex(base + grid.corner_offset(lower), upper ^ lower)
-    };
-    let (ins, outs): (Vec<usize>, Vec<usize>) = (0..4).partition(|&v| is_in[v]);
-    let orient = |mut tri: [u32; 3], flip: bool| {
-        if flip {
-            tri.swap(1, 2);
-        }
-        tri
-    };
-    match ins.len() {
-        1 => {
-            // The triangle must face away from the single inside corner.
-            let (i, o) = (ins[0], &outs);
-            let flip = odd_tet ^ is_odd_permutation([i, o[0], o[1], o[2]]);
-            out.push(orient([edge(i, o[0]), edge(i, o[1]), edge(i, o[2])], flip));
-        }
-        3 => {
-            // The triangle must face towards the single outside corner.
-            let (o, i) = (outs[0], &ins);
-            let flip = !(odd_tet ^ is_odd_permutation([o, i[0], i[1], i[2]]));
-            out.push(orient([edge(o, i[0]), edge(o, i[1]), edge(o, i[2])], flip));
-        }
-        2 => {
-            // For a positive tet and an even (i, j, k, l) the quad ik, il, jl, jk faces the
-            // outside pair k, l.
-            let (i, j, k, l) = (ins[0], ins[1], outs[0], outs[1]);
-            let mut quad = [edge(i, k), edge(i, l), edge(j, l), edge(j, k)];
-            if odd_tet ^ is_odd_permutation([i, j, k, l]) {
-                quad.reverse();
-            }
-            // Split along the shorter diagonal for better-shaped triangles.
-            let p = quad.map(|v| positions[v as usize]);
-            if p[0].distance_squared(p[2]) <= p[1].distance_squared(p[3]) {
-                out.extend([[quad[0], quad[1], quad[2]], [quad[0], quad[2], quad[3]]]);
-            } else {
-                out.extend([[quad[1], quad[2], quad[3]], [quad[1], quad[3], quad[0]]]);
-            }
-        }
-        _ => {}
-    }
 }
 
 /// Points per independently seeded chunk in [`sample_surface`] and [`add_noise`]. Fixed, so the
@@ -724,26 +624,6 @@ pub fn add_noise(cloud: &mut Mesh, position_sigma: f32, normal_sigma_radians: f3
 mod tests {
     use super::*;
     use crate::topology::{analyze, signed_volume};
-
-    #[test]
-    fn kuhn_tets_are_paths_with_the_stated_orientation() {
-        for (corners, odd) in KUHN_TETS {
-            assert_eq!((corners[0], corners[3]), (0, 7));
-            for w in corners.windows(2) {
-                assert_eq!((w[1] & w[0]), w[0], "{corners:?} is not monotone");
-                assert_eq!((w[1] ^ w[0]).count_ones(), 1);
-            }
-            let v = corners.map(|c| {
-                Vec3::new(
-                    f32::from(c & 1),
-                    f32::from((c >> 1) & 1),
-                    f32::from((c >> 2) & 1),
-                )
-            });
-            let det = (v[1] - v[0]).dot((v[2] - v[0]).cross(v[3] - v[0]));
-            assert_eq!(det < 0.0, odd, "{corners:?}");
-        }
-    }
 
     #[test]
     fn implicit_sphere_is_watertight_and_outward() {

@@ -1,0 +1,438 @@
+//! Marching tetrahedra: the cube split and per-tetrahedron triangulation shared by the dense
+//! polygoniser of generated shapes ([`crate::shapes::implicit_mesh`]) and the sparse surface
+//! tracker that reconstruction uses to mesh its implicit function.
+//!
+//! Every cube is split the same way (Kuhn), vertices sit on grid edges and diagonals where the
+//! function changes sign, and each such vertex is shared by every tetrahedron around its edge:
+//! the result is watertight and 2-manifold, with outward (counter-clockwise) triangles for a
+//! function that is negative inside.
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::progress::Threads;
+use glam::Vec3;
+use rayon::prelude::*;
+use std::collections::{HashMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// The tetrahedra of the Kuhn (Freudenthal) split of a cube: one per axis permutation, each the
+/// path from corner 0 to corner 7 along the permuted axes. Corners are numbered by bits
+/// (x = 1, y = 2, z = 4). Along each path the corners only gain bits, so every tet edge runs from
+/// a corner to a componentwise-greater one; all cubes split their faces along the same
+/// diagonals, so neighbouring cubes agree. The bool is true for an odd permutation, whose tet
+/// is negatively oriented.
+pub(crate) const KUHN_TETS: [([u8; 4], bool); 6] = [
+    ([0, 1, 3, 7], false), // x, y, z
+    ([0, 2, 6, 7], false), // y, z, x
+    ([0, 4, 5, 7], false), // z, x, y
+    ([0, 1, 5, 7], true),  // x, z, y
+    ([0, 2, 3, 7], true),  // y, x, z
+    ([0, 4, 6, 7], true),  // z, y, x
+];
+
+/// Interpolation parameters closer than this to a grid point are pushed away from it, so no
+/// two vertices coincide (a value exactly 0 at a grid point counts as slightly positive).
+const MIN_EDGE_FRACTION: f32 = 1e-3;
+
+/// Where along an edge from value `fa` to value `fb` (of opposite signs) the zero lies, in
+/// `(0, 1)`, kept away from the ends.
+pub(crate) fn crossing_fraction(fa: f32, fb: f32) -> f32 {
+    let t = fa / (fa - fb);
+    let t = if t.is_finite() { t } else { 0.5 };
+    t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION)
+}
+
+/// Emits the outward triangles of one cube whose corners (bits x = 1, y = 2, z = 4) are
+/// `inside` or not. `vertex(lower, upper)` gives the index and position of the vertex on the
+/// cube edge or diagonal from corner `lower` to corner `upper` (`lower` ⊂ `upper` as bit sets),
+/// creating it on first use.
+pub(crate) fn cube_triangles(
+    inside: &[bool; 8],
+    mut vertex: impl FnMut(u8, u8) -> (u32, Vec3),
+    out: &mut Vec<[u32; 3]>,
+) {
+    if inside.iter().all(|&x| x == inside[0]) {
+        return;
+    }
+    for (corners, odd_tet) in KUHN_TETS {
+        tetrahedron(corners, odd_tet, inside, &mut vertex, out);
+    }
+}
+
+/// Parity of a permutation of 0..4 (true when odd), by counting inversions.
+fn is_odd_permutation(p: [usize; 4]) -> bool {
+    let mut inversions = 0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            if p[i] > p[j] {
+                inversions += 1;
+            }
+        }
+    }
+    inversions % 2 == 1
+}
+
+/// Emits the outward triangles of one tetrahedron. `corners` are the tet's cube corners, each
+/// containing the previous one; `odd_tet` is true when the tet is negatively oriented.
+///
+/// For a positively oriented tet (v0, v1, v2, v3), the triangle through the edges v0-v1, v0-v2,
+/// v0-v3 (in that order) faces away from v0. Relabelling the tet by an odd permutation flips
+/// that, so every case reduces to "write the vertices in a fixed order, flip when the
+/// permutation's parity and the tet's orientation disagree".
+fn tetrahedron(
+    corners: [u8; 4],
+    odd_tet: bool,
+    inside: &[bool; 8],
+    vertex: &mut impl FnMut(u8, u8) -> (u32, Vec3),
+    out: &mut Vec<[u32; 3]>,
+) {
+    let is_in: [bool; 4] = corners.map(|c| inside[c as usize]);
+    // The vertex on the edge between tet corners x and y.
+    let mut edge = |x: usize, y: usize| vertex(corners[x.min(y)], corners[x.max(y)]);
+    let (ins, outs): (Vec<usize>, Vec<usize>) = (0..4).partition(|&v| is_in[v]);
+    let orient = |mut tri: [u32; 3], flip: bool| {
+        if flip {
+            tri.swap(1, 2);
+        }
+        tri
+    };
+    match ins.len() {
+        1 => {
+            // The triangle must face away from the single inside corner.
+            let (i, o) = (ins[0], &outs);
+            let flip = odd_tet ^ is_odd_permutation([i, o[0], o[1], o[2]]);
+            out.push(orient(
+                [edge(i, o[0]).0, edge(i, o[1]).0, edge(i, o[2]).0],
+                flip,
+            ));
+        }
+        3 => {
+            // The triangle must face towards the single outside corner.
+            let (o, i) = (outs[0], &ins);
+            let flip = !(odd_tet ^ is_odd_permutation([o, i[0], i[1], i[2]]));
+            out.push(orient(
+                [edge(o, i[0]).0, edge(o, i[1]).0, edge(o, i[2]).0],
+                flip,
+            ));
+        }
+        2 => {
+            // For a positive tet and an even (i, j, k, l) the quad ik, il, jl, jk faces the
+            // outside pair k, l.
+            let (i, j, k, l) = (ins[0], ins[1], outs[0], outs[1]);
+            let mut quad = [edge(i, k), edge(i, l), edge(j, l), edge(j, k)];
+            if odd_tet ^ is_odd_permutation([i, j, k, l]) {
+                quad.reverse();
+            }
+            // Split along the shorter diagonal for better-shaped triangles.
+            let (v, p) = (quad.map(|q| q.0), quad.map(|q| q.1));
+            if p[0].distance_squared(p[2]) <= p[1].distance_squared(p[3]) {
+                out.extend([[v[0], v[1], v[2]], [v[0], v[2], v[3]]]);
+            } else {
+                out.extend([[v[1], v[2], v[3]], [v[1], v[3], v[0]]]);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// A regular grid: point `(i, j, k)` is at `origin + cell * (i, j, k)` for `i < dims[0]`, etc.
+/// Cell `(i, j, k)` is the cube whose lowest corner is point `(i, j, k)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Grid {
+    pub origin: Vec3,
+    pub cell: f32,
+    pub dims: [u32; 3],
+}
+
+/// Grid coordinates fit in 21 bits each, so a point or cell packs into one `u64` key.
+pub(crate) const MAX_GRID_POINTS_PER_AXIS: u32 = 1 << 21;
+
+impl Grid {
+    fn key(i: u32, j: u32, k: u32) -> u64 {
+        u64::from(i) | u64::from(j) << 21 | u64::from(k) << 42
+    }
+
+    fn unkey(key: u64) -> [u32; 3] {
+        let mask = (1 << 21) - 1;
+        [
+            (key & mask) as u32,
+            (key >> 21 & mask) as u32,
+            (key >> 42) as u32,
+        ]
+    }
+
+    fn point(&self, [i, j, k]: [u32; 3]) -> Vec3 {
+        self.origin + self.cell * Vec3::new(i as f32, j as f32, k as f32)
+    }
+
+    fn on_border(&self, [i, j, k]: [u32; 3]) -> bool {
+        i == 0
+            || j == 0
+            || k == 0
+            || i + 1 >= self.dims[0]
+            || j + 1 >= self.dims[1]
+            || k + 1 >= self.dims[2]
+    }
+
+    /// The cell containing `p` (clamped into the grid).
+    pub fn cell_of(&self, p: Vec3) -> [u32; 3] {
+        let q = ((p - self.origin) / self.cell).floor();
+        [0, 1, 2].map(|a| (q[a].max(0.0) as u32).min(self.dims[a].saturating_sub(2)))
+    }
+}
+
+/// A fast hasher for the packed grid keys (multiplicative, like FxHash).
+#[derive(Default)]
+struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_u8(&mut self, x: u8) {
+        self.write_u64(u64::from(x));
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+type FastMap<K, V> = HashMap<K, V, BuildHasherDefault<KeyHasher>>;
+type FastSet<K> = HashSet<K, BuildHasherDefault<KeyHasher>>;
+
+/// The six faces of a cube: the axis bit, and whether it is the face where that bit is set.
+const FACES: [(u8, bool); 6] = [
+    (1, false),
+    (1, true),
+    (2, false),
+    (2, true),
+    (4, false),
+    (4, true),
+];
+
+/// Polygonises the part of the zero set of `f` (negative inside) that passes through the
+/// `seeds` cells, by surface tracking (Bloomenthal 1994): a cell is visited when it shares a
+/// face whose corners change sign with a visited cell that crosses the surface. Only the cells
+/// along the surface are ever evaluated, so the cost follows the surface's area, not the
+/// grid's volume. Points on the grid's outer layer count as outside, so the result is closed.
+/// `f` is evaluated in parallel, one wave of cells at a time; the output is deterministic.
+/// More than `max_cells` visited cells is refused with [`Error::TooLarge`].
+pub(crate) fn track_surface(
+    f: &(dyn Fn(Vec3) -> f32 + Sync),
+    grid: &Grid,
+    seeds: &[[u32; 3]],
+    max_cells: usize,
+    threads: &Threads,
+) -> Result<Mesh> {
+    let cells_per_axis = grid.dims.map(|d| d.saturating_sub(1));
+    let mut visited: FastSet<u64> = FastSet::default();
+    let mut frontier: Vec<u64> = seeds
+        .iter()
+        .filter(|c| (0..3).all(|a| c[a] < cells_per_axis[a]))
+        .map(|c| Grid::key(c[0], c[1], c[2]))
+        .collect();
+    frontier.sort_unstable();
+    frontier.dedup();
+    visited.extend(frontier.iter().copied());
+
+    let mut values: FastMap<u64, f32> = FastMap::default();
+    let mut vertices: FastMap<(u64, u8), u32> = FastMap::default();
+    let mut positions: Vec<Vec3> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let corner = |cell: [u32; 3], c: u8| {
+        [
+            cell[0] + u32::from(c & 1),
+            cell[1] + u32::from(c >> 1 & 1),
+            cell[2] + u32::from(c >> 2 & 1),
+        ]
+    };
+
+    while !frontier.is_empty() {
+        if visited.len() > max_cells {
+            return Err(Error::TooLarge(format!(
+                "the surface crosses more than {max_cells} grid cells"
+            )));
+        }
+        // Evaluate the corners not seen yet, in parallel.
+        let mut needed: Vec<u64> = frontier
+            .iter()
+            .flat_map(|&c| {
+                let cell = Grid::unkey(c);
+                (0..8u8).map(move |k| {
+                    let [i, j, l] = corner(cell, k);
+                    Grid::key(i, j, l)
+                })
+            })
+            .filter(|p| !values.contains_key(p))
+            .collect();
+        needed.sort_unstable();
+        needed.dedup();
+        let computed: Vec<f32> = threads.run(|| {
+            needed
+                .par_iter()
+                .map(|&p| {
+                    let ijk = Grid::unkey(p);
+                    let v = if grid.on_border(ijk) {
+                        f32::MAX
+                    } else {
+                        f(grid.point(ijk))
+                    };
+                    if v.is_nan() {
+                        f32::MAX
+                    } else {
+                        v
+                    }
+                })
+                .collect()
+        });
+        values.extend(needed.into_iter().zip(computed));
+
+        // Triangulate the wave's cells in order and collect the next wave.
+        let mut next = Vec::new();
+        for &c in &frontier {
+            let cell = Grid::unkey(c);
+            let value = |k: u8| {
+                let [i, j, l] = corner(cell, k);
+                values[&Grid::key(i, j, l)]
+            };
+            let inside: [bool; 8] = std::array::from_fn(|k| value(k as u8) < 0.0);
+            if inside.iter().all(|&x| x == inside[0]) {
+                continue;
+            }
+            cube_triangles(
+                &inside,
+                |lower, upper| {
+                    let a = corner(cell, lower);
+                    let key = (Grid::key(a[0], a[1], a[2]), upper ^ lower);
+                    if let Some(&v) = vertices.get(&key) {
+                        return (v, positions[v as usize]);
+                    }
+                    let b = corner(cell, upper);
+                    let t = crossing_fraction(value(lower), value(upper));
+                    let (pa, pb) = (grid.point(a), grid.point(b));
+                    let p = pa + (pb - pa) * t;
+                    let v = positions.len() as u32;
+                    positions.push(p);
+                    vertices.insert(key, v);
+                    (v, p)
+                },
+                &mut triangles,
+            );
+            for (bit, upper) in FACES {
+                let face: Vec<bool> = (0..8u8)
+                    .filter(|k| (k & bit != 0) == upper)
+                    .map(|k| inside[k as usize])
+                    .collect();
+                if face.iter().all(|&x| x == face[0]) {
+                    continue;
+                }
+                let axis = bit.trailing_zeros() as usize;
+                let mut n = cell;
+                if upper {
+                    n[axis] += 1;
+                } else if n[axis] == 0 {
+                    continue;
+                } else {
+                    n[axis] -= 1;
+                }
+                if n[axis] < cells_per_axis[axis] && visited.insert(Grid::key(n[0], n[1], n[2])) {
+                    next.push(Grid::key(n[0], n[1], n[2]));
+                }
+            }
+        }
+        next.sort_unstable();
+        frontier = next;
+    }
+    if positions.len() >= u32::MAX as usize {
+        return Err(Error::TooLarge("more than 2^32 vertices".into()));
+    }
+    Ok(Mesh {
+        positions,
+        normals: None,
+        triangles,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::topology::{analyze, signed_volume};
+
+    #[test]
+    fn kuhn_tets_are_paths_with_the_stated_orientation() {
+        for (corners, odd) in KUHN_TETS {
+            assert_eq!((corners[0], corners[3]), (0, 7));
+            for w in corners.windows(2) {
+                assert_eq!((w[1] & w[0]), w[0], "{corners:?} is not monotone");
+                assert_eq!((w[1] ^ w[0]).count_ones(), 1);
+            }
+            let v = corners.map(|c| {
+                Vec3::new(
+                    f32::from(c & 1),
+                    f32::from((c >> 1) & 1),
+                    f32::from((c >> 2) & 1),
+                )
+            });
+            let det = (v[1] - v[0]).dot((v[2] - v[0]).cross(v[3] - v[0]));
+            assert_eq!(det < 0.0, odd, "{corners:?}");
+        }
+    }
+
+    fn torus(p: Vec3) -> f32 {
+        let q = glam::Vec2::new(glam::Vec2::new(p.x, p.y).length() - 1.0, p.z);
+        q.length() - 0.35
+    }
+
+    #[test]
+    fn tracking_from_one_seed_finds_the_whole_closed_surface() {
+        let grid = Grid {
+            origin: Vec3::splat(-1.6),
+            cell: 0.05,
+            dims: [65, 65, 65],
+        };
+        // One seed cell on the torus' outer equator.
+        let seed = grid.cell_of(Vec3::new(1.33, 0.01, 0.01));
+        let mesh =
+            track_surface(&torus, &grid, &[seed], 1 << 20, &Threads::new(0).unwrap()).unwrap();
+        let report = analyze(&mesh);
+        assert!(report.is_watertight(), "{report:?}");
+        assert_eq!(report.genus(), Some(1));
+        assert_eq!(report.components, 1);
+        let volume = signed_volume(&mesh);
+        let exact = 2.0 * std::f64::consts::PI.powi(2) * 1.0 * 0.35f64.powi(2);
+        assert!(
+            (volume / exact - 1.0).abs() < 0.02,
+            "volume {volume} vs {exact}"
+        );
+        // Same mesh as the dense polygoniser on the same grid.
+        let dense =
+            crate::shapes::implicit_mesh(torus, grid.origin, grid.origin + grid.cell * 64.0, 64);
+        assert_eq!(dense.triangles.len(), mesh.triangles.len());
+    }
+
+    #[test]
+    fn a_surface_leaving_the_grid_is_closed_at_its_border_and_seeds_outside_are_ignored() {
+        let grid = Grid {
+            origin: Vec3::splat(-1.0),
+            cell: 0.1,
+            dims: [21, 21, 21],
+        };
+        let plane = |p: Vec3| p.z;
+        let mesh = track_surface(
+            &plane,
+            &grid,
+            &[[10, 10, 9], [99, 0, 0]],
+            1 << 20,
+            &Threads::new(1).unwrap(),
+        )
+        .unwrap();
+        assert!(analyze(&mesh).is_watertight());
+        let too_small = track_surface(&plane, &grid, &[[10, 10, 9]], 10, &Threads::new(1).unwrap());
+        assert!(matches!(too_small, Err(Error::TooLarge(_))));
+    }
+}
