@@ -219,7 +219,9 @@ const FACES: [(u8, bool); 6] = [
 /// `seeds` cells, by surface tracking (Bloomenthal 1994): a cell is visited when it shares a
 /// face whose corners change sign with a visited cell that crosses the surface. Only the cells
 /// along the surface are ever evaluated, so the cost follows the surface's area, not the
-/// grid's volume. Points on the grid's outer layer count as outside, so the result is closed.
+/// grid's volume. Points on the grid's outer layer count as outside, so the surface is closed
+/// there. Where `f` is NaN it is undefined: a cell with an undefined corner is neither
+/// triangulated nor crossed (the surface gets a boundary there).
 /// `f` is evaluated in parallel, one wave of cells at a time; the output is deterministic.
 /// More than `max_cells` visited cells is refused with [`Error::TooLarge`].
 pub(crate) fn track_surface(
@@ -277,15 +279,10 @@ pub(crate) fn track_surface(
                 .par_iter()
                 .map(|&p| {
                     let ijk = Grid::unkey(p);
-                    let v = if grid.on_border(ijk) {
+                    if grid.on_border(ijk) {
                         f32::MAX
                     } else {
                         f(grid.point(ijk))
-                    };
-                    if v.is_nan() {
-                        f32::MAX
-                    } else {
-                        v
                     }
                 })
                 .collect()
@@ -300,8 +297,9 @@ pub(crate) fn track_surface(
                 let [i, j, l] = corner(cell, k);
                 values[&Grid::key(i, j, l)]
             };
-            let inside: [bool; 8] = std::array::from_fn(|k| value(k as u8) < 0.0);
-            if inside.iter().all(|&x| x == inside[0]) {
+            let values: [f32; 8] = std::array::from_fn(|k| value(k as u8));
+            let inside = values.map(|v| v < 0.0);
+            if values.iter().any(|v| v.is_nan()) || inside.iter().all(|&x| x == inside[0]) {
                 continue;
             }
             cube_triangles(

@@ -6,6 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
+use vstree::reconstruct::{reconstruct, ReconstructParams, ReconstructStats};
 use vstree::simplify::{simplify, SimplifyParams, SimplifyStats};
 use vstree::tree::{Metric, TreeKind, TreeParams, TreeStats};
 use vstree::{io, MeshSampling, Progress, SampleSet, Threads};
@@ -38,6 +39,33 @@ enum Command {
         /// Which mesh elements become samples.
         #[arg(long, value_enum, default_value_t = Sampling::Vertices)]
         sampling: Sampling,
+        /// Write PLY as text instead of binary.
+        #[arg(long)]
+        ascii: bool,
+    },
+    /// Reconstruct a triangle mesh from a point cloud with normals (paper section 5).
+    ///
+    /// The T-layer of the tree gives a coarse closed base mesh of the right genus; it is then
+    /// refined (1-to-4 on curved PN triangles) and its new vertices pulled onto the samples by
+    /// the quadtrees, until the mesh is close enough or the tree has no detail left.
+    Reconstruct {
+        /// Input point cloud with normals: .ply, .xyz, .pwn (or a mesh: its vertices are used).
+        input: PathBuf,
+        /// Output mesh (format from the extension). Written atomically.
+        output: PathBuf,
+        #[command(flatten)]
+        tree: TreeArgs,
+        /// Stop refining once the RMS distance from the samples to the mesh is at most this
+        /// fraction of the bounding-box diagonal (0 = refine while the tree has detail left).
+        #[arg(long, default_value_t = 0.0)]
+        target: f64,
+        /// Most refinement levels (each one multiplies the triangles by 4).
+        #[arg(long, default_value_t = 6)]
+        levels: u32,
+        /// Remove faces farther than this many grid cells from every sample, so an open scan
+        /// gives an open mesh (0 = keep the closed surface).
+        #[arg(long, default_value_t = 0.0)]
+        trim: f32,
         /// Write PLY as text instead of binary.
         #[arg(long)]
         ascii: bool,
@@ -169,6 +197,43 @@ fn run(command: Command) -> vstree::Result<()> {
             }
             Ok(())
         }
+        Command::Reconstruct {
+            input,
+            output,
+            tree,
+            target,
+            levels,
+            trim,
+            ascii,
+        } => {
+            let params = ReconstructParams {
+                tree: tree.params(),
+                target_distance: target,
+                max_levels: levels,
+                trim,
+                threads: tree.threads,
+                ..ReconstructParams::default()
+            };
+            params.check()?;
+            let (mut cloud, read_s) = timed(|| io::read(&input))?;
+            cloud.triangles.clear();
+            let (out, stats) = with_progress(tree.quiet, |progress| {
+                reconstruct(&cloud, &params, progress)
+            })?;
+            let (_, write_s) =
+                timed(|| io::write_with(&output, &out, &io::WriteOptions { ascii }))?;
+            if !tree.quiet {
+                print_reconstruct(
+                    &input,
+                    &output,
+                    cloud.positions.len(),
+                    &stats,
+                    read_s,
+                    write_s,
+                );
+            }
+            Ok(())
+        }
         Command::Stats {
             input,
             tree,
@@ -280,5 +345,58 @@ fn print_simplify(input: &Path, output: &Path, s: &SimplifyStats, read_s: f64, w
     println!(
         "time: read {:.3} s, samples {:.3} s, tree {:.3} s, clustering {:.3} s, write {:.3} s",
         read_s, s.seconds_samples, s.seconds_tree, s.seconds_cluster, write_s
+    );
+}
+
+fn print_reconstruct(
+    input: &Path,
+    output: &Path,
+    points: usize,
+    s: &ReconstructStats,
+    read_s: f64,
+    write_s: f64,
+) {
+    println!("{}: {} points", input.display(), points);
+    print_tree(&s.tree);
+    let genus = s
+        .base_genus
+        .map_or("not a closed manifold".to_string(), |g| {
+            format!("genus {g}")
+        });
+    println!(
+        "grid: {} cells across, {} triangles polygonised",
+        s.grid_cells, s.fine_triangles
+    );
+    println!(
+        "M0: {} vertices, {} triangles, {genus}, error {:.2e}",
+        s.base_vertices, s.base_triangles, s.base_error
+    );
+    for (k, level) in s.levels.iter().enumerate() {
+        println!(
+            "level {}: {} new vertices, {} displaced by the quadtrees",
+            k + 1,
+            level.new_vertices,
+            level.displaced
+        );
+    }
+    println!(
+        "error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)",
+        s.final_error, s.final_max_error
+    );
+    if s.trimmed_triangles > 0 {
+        println!(
+            "trimmed: {} triangles far from the samples",
+            s.trimmed_triangles
+        );
+    }
+    println!(
+        "{}: {} vertices, {} triangles",
+        output.display(),
+        s.output_vertices,
+        s.output_triangles
+    );
+    println!(
+        "time: read {:.3} s, tree {:.3} s, base mesh {:.3} s, refinement {:.3} s, trim {:.3} s, write {:.3} s",
+        read_s, s.seconds_tree, s.seconds_base, s.seconds_refine, s.seconds_trim, write_s
     );
 }

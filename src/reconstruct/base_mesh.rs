@@ -61,6 +61,44 @@ fn vertex_neighbours(mesh: &Mesh) -> Vec<Vec<u32>> {
     neighbours
 }
 
+/// A closed surface needs at least this many vertices: a component that spans fewer T-nodes
+/// cannot be represented at the T-layer (it is a bubble of the implicit function).
+const MIN_T_NODES_PER_COMPONENT: usize = 4;
+
+/// Marks the vertices of components that span fewer than [`MIN_T_NODES_PER_COMPONENT`]
+/// T-nodes.
+fn small_components(mesh: &Mesh, labels: &[u32]) -> Vec<bool> {
+    let neighbours = vertex_neighbours(mesh);
+    let mut component = vec![u32::MAX; mesh.positions.len()];
+    let mut dropped = vec![false; mesh.positions.len()];
+    for start in 0..mesh.positions.len() {
+        if component[start] != u32::MAX || neighbours[start].is_empty() {
+            continue;
+        }
+        let mut members = vec![start as u32];
+        component[start] = start as u32;
+        let mut k = 0;
+        while k < members.len() {
+            for &w in &neighbours[members[k] as usize] {
+                if component[w as usize] == u32::MAX {
+                    component[w as usize] = start as u32;
+                    members.push(w);
+                }
+            }
+            k += 1;
+        }
+        let mut t_nodes: Vec<u32> = members.iter().map(|&v| labels[v as usize]).collect();
+        t_nodes.sort_unstable();
+        t_nodes.dedup();
+        if t_nodes.len() < MIN_T_NODES_PER_COMPONENT {
+            for &v in &members {
+                dropped[v as usize] = true;
+            }
+        }
+    }
+    dropped
+}
+
 /// M0 with, per vertex, its T-node and how many fine vertices it stands for.
 pub(crate) struct BaseMesh {
     pub mesh: Mesh,
@@ -68,9 +106,22 @@ pub(crate) struct BaseMesh {
 }
 
 /// Collapses every edge whose ends share a label, while the link condition allows, and places
-/// each remaining vertex at the mean of the fine vertices it absorbed.
+/// each remaining vertex at the mean of the fine vertices it absorbed. Components with no
+/// labelled vertex (bubbles of the implicit function away from every T-node) are dropped.
 pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32]) -> BaseMesh {
     let mut c = Collapser::new(fine);
+    let dropped = small_components(fine, labels);
+    for (t, tri) in fine.triangles.iter().enumerate() {
+        if tri
+            .iter()
+            .any(|&v| labels[v as usize] == UNLABELLED || dropped[v as usize])
+        {
+            c.alive_face[t] = false;
+            for &v in tri {
+                c.alive_vertex[v as usize] = false;
+            }
+        }
+    }
     loop {
         let mut collapsed = 0usize;
         for t in 0..c.triangles.len() {

@@ -1,4 +1,359 @@
-//! Surface reconstruction from a point cloud (paper §5).
+//! Surface reconstruction from a point cloud (paper §5, POINT_TO_MESH):
+//!
+//! 1. build the VS-Tree of the samples (the L2 bound is the de-noising control);
+//! 2. blend the T-nodes' planes into one implicit function ([`implicit`]), polygonise it on a
+//!    grid as fine as the deepest T-node ([`crate::polygonize`]), and cluster that mesh at the
+//!    T-layer into the base mesh M0, one vertex per T-node ([`base_mesh`]);
+//! 3. refine: split 1-to-4 on PN triangles and displace by the quadtrees ([`refine`]), until
+//!    the mesh is close enough to the samples or the quadtrees have no detail left;
+//! 4. optionally trim faces far from every sample, so an open scan gives an open mesh.
+//!
+//! error(M, S), where the paper leaves it open: the root mean square of the distances from the
+//! samples (at most [`ERROR_SAMPLES`] of them, evenly spread) to the mesh, over the bounding
+//! box's diagonal; the maximum is reported too.
 
 mod base_mesh;
 mod implicit;
+mod refine;
+
+pub use refine::LevelStats;
+
+use crate::distance::{PointBvh, TriangleBvh};
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::polygonize::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
+use crate::progress::{Progress, Threads};
+use crate::samples::SampleSet;
+use crate::topology;
+use crate::tree::{self, NodeKind, TreeParams, TreeStats, VsTree};
+use glam::Vec3;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// At most this many samples are measured for error(M, S).
+pub const ERROR_SAMPLES: usize = 100_000;
+/// T-node supports: balls of this many times the cube's half diagonal (MPU's α = 0.75 of the
+/// full diagonal).
+const SUPPORT_SCALE: f32 = 1.5;
+/// Beyond this many grid cells from every sample, the implicit function is pushed outside.
+const FAR_FROM_SAMPLES: f32 = 2.0;
+/// The polygonisation gives up beyond this many grid cells along the surface.
+const MAX_GRID_CELLS: usize = 50_000_000;
+/// Fewer points than this cannot define a surface.
+pub const MIN_POINTS: usize = 10;
+
+/// Parameters of [`reconstruct`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReconstructParams {
+    /// The tree: its L2 bound smooths noise (larger = smoother, fewer details); `d_a`/`d_d`
+    /// set how deep the T-layer goes, i.e. how dense M0 is where curvature is high.
+    pub tree: TreeParams,
+    /// Stop refining once error(M, S) (RMS distance over the diagonal) is at most this.
+    /// 0 = refine until the quadtrees have no detail left or `max_levels`.
+    pub target_distance: f64,
+    /// Most refinement levels (each multiplies the triangle count by 4). 0-12.
+    pub max_levels: u32,
+    /// A level that displaces fewer than this fraction of its new vertices ends refinement:
+    /// the quadtrees have no detail left for further levels. In [0, 1].
+    pub min_displaced: f64,
+    /// No level is started that would exceed this many triangles.
+    pub max_triangles: usize,
+    /// The polygonisation grid is as fine as the deepest T-node, but never finer than
+    /// 2^`max_grid_depth` cells across. 4-20.
+    pub max_grid_depth: u32,
+    /// Remove faces farther than this many grid cells from every sample (open scans give
+    /// open meshes); 0 keeps the closed surface.
+    pub trim: f32,
+    /// Worker threads; 0 = all cores.
+    pub threads: usize,
+}
+
+impl Default for ReconstructParams {
+    fn default() -> Self {
+        ReconstructParams {
+            tree: TreeParams {
+                error: 5e-4,
+                ..TreeParams::default()
+            },
+            target_distance: 0.0,
+            max_levels: 6,
+            min_displaced: 0.02,
+            max_triangles: 20_000_000,
+            max_grid_depth: 10,
+            trim: 0.0,
+            threads: 0,
+        }
+    }
+}
+
+impl ReconstructParams {
+    /// Rejects values outside their documented ranges, naming the parameter.
+    pub fn check(&self) -> Result<()> {
+        self.tree.check()?;
+        if !(self.target_distance.is_finite() && self.target_distance >= 0.0) {
+            return Err(Error::param(
+                "target_distance",
+                format!("{}: must be >= 0", self.target_distance),
+            ));
+        }
+        if self.max_levels > 12 {
+            return Err(Error::param(
+                "max_levels",
+                format!("{}: must be in 0..=12", self.max_levels),
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.min_displaced) {
+            return Err(Error::param(
+                "min_displaced",
+                format!("{}: must be in [0, 1]", self.min_displaced),
+            ));
+        }
+        if self.max_triangles == 0 || self.max_triangles > u32::MAX as usize {
+            return Err(Error::param(
+                "max_triangles",
+                format!("{}: must be in 1..=2^32-1", self.max_triangles),
+            ));
+        }
+        if !(4..=20).contains(&self.max_grid_depth) {
+            return Err(Error::param(
+                "max_grid_depth",
+                format!("{}: must be in 4..=20", self.max_grid_depth),
+            ));
+        }
+        if !(self.trim.is_finite() && self.trim >= 0.0) {
+            return Err(Error::param("trim", format!("{}: must be >= 0", self.trim)));
+        }
+        Ok(())
+    }
+}
+
+/// What [`reconstruct`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ReconstructStats {
+    pub tree: TreeStats,
+    /// Cells across the polygonisation grid (a power of two).
+    pub grid_cells: u32,
+    pub fine_triangles: usize,
+    pub base_vertices: usize,
+    pub base_triangles: usize,
+    /// Genus of M0 when it is a closed manifold.
+    pub base_genus: Option<u32>,
+    pub levels: Vec<LevelStats>,
+    /// error(M, S) of M0 and of the final mesh: RMS and max sample-to-mesh distance over the
+    /// diagonal.
+    pub base_error: f64,
+    pub final_error: f64,
+    pub final_max_error: f64,
+    pub trimmed_triangles: usize,
+    pub output_vertices: usize,
+    pub output_triangles: usize,
+    pub seconds_tree: f64,
+    pub seconds_base: f64,
+    pub seconds_refine: f64,
+    pub seconds_trim: f64,
+}
+
+/// Reconstructs a triangle mesh from a point cloud with (outward) normals.
+pub fn reconstruct(
+    cloud: &Mesh,
+    params: &ReconstructParams,
+    progress: &mut Progress,
+) -> Result<(Mesh, ReconstructStats)> {
+    params.check()?;
+    if cloud.positions.len() < MIN_POINTS {
+        return Err(Error::input(format!(
+            "{} points: at least {MIN_POINTS} are needed",
+            cloud.positions.len()
+        )));
+    }
+    let samples = SampleSet::from_cloud(cloud)?;
+    let threads = Threads::new(params.threads)?;
+    let mut stats = ReconstructStats::default();
+
+    let t0 = Instant::now();
+    let tree = tree::build(
+        &samples,
+        &params.tree,
+        &threads,
+        &mut progress.stage(0.0, 0.3),
+    )?;
+    stats.tree = tree.stats();
+    if stats.tree.t_nodes == 0 {
+        return Err(Error::input("no part of the cloud is a height field: no T-node, no surface (are the normals consistent?)"));
+    }
+    let t1 = Instant::now();
+
+    progress.report(0.3, "base mesh")?;
+    let grid = polygonisation_grid(&tree, params.max_grid_depth);
+    stats.grid_cells = grid.dims[0] - 5;
+    let seeds = sample_cells(&grid, &samples.positions, &threads);
+    let blend = implicit::PlaneBlend::new(&tree, SUPPORT_SCALE, 1.5 * grid.cell);
+    let near = threads.run(|| PointBvh::new(&samples.positions));
+    let tolerance = FAR_FROM_SAMPLES * grid.cell;
+    let f = |p: Vec3| blend.eval(p) + (near.distance(p) - tolerance).max(0.0);
+    let fine = track_surface(&f, &grid, &seeds, MAX_GRID_CELLS, &threads)?;
+    if fine.triangles.is_empty() {
+        return Err(Error::input("the blended T-node planes have no zero crossing near the samples (are the normals consistent?)"));
+    }
+    stats.fine_triangles = fine.triangles.len();
+    progress.report(0.4, "base mesh")?;
+    let labels = base_mesh::label_vertices(&tree, &fine);
+    let base = base_mesh::cluster_at_t_layer(&fine, &labels);
+    stats.base_vertices = base.mesh.positions.len();
+    stats.base_triangles = base.mesh.triangles.len();
+    stats.base_genus = topology::analyze(&base.mesh).genus();
+    let mut surface = refine::Surface {
+        normals: base
+            .labels
+            .iter()
+            .map(|&t| tree.frames[tree.nodes[t as usize].frame as usize].normal)
+            .collect(),
+        positions: base.mesh.positions,
+        labels: base.labels,
+        triangles: base.mesh.triangles,
+    };
+    let t2 = Instant::now();
+
+    let measured = evenly_spread(&samples.positions, ERROR_SAMPLES);
+    let (mut rms, mut max) = sample_error(&surface, &measured, tree.diagonal, &threads);
+    stats.base_error = rms;
+    let refiner = refine::Refiner::new(&tree, &threads);
+    for level in 0..params.max_levels {
+        if rms <= params.target_distance || 4 * surface.triangles.len() > params.max_triangles {
+            break;
+        }
+        progress.report(
+            0.5 + 0.45 * level as f32 / params.max_levels as f32,
+            "refining",
+        )?;
+        let (refined, level_stats) = refiner.refine(&surface, &threads);
+        surface = refined;
+        stats.levels.push(level_stats);
+        (rms, max) = sample_error(&surface, &measured, tree.diagonal, &threads);
+        if (level_stats.displaced as f64) < params.min_displaced * level_stats.new_vertices as f64 {
+            break;
+        }
+    }
+    (stats.final_error, stats.final_max_error) = (rms, max);
+    let t3 = Instant::now();
+
+    progress.report(0.95, "trimming")?;
+    let mut mesh = Mesh {
+        positions: surface.positions,
+        normals: Some(surface.normals),
+        triangles: surface.triangles,
+    };
+    if params.trim > 0.0 {
+        stats.trimmed_triangles = trim_far_faces(
+            &mut mesh,
+            &samples.positions,
+            params.trim * grid.cell,
+            &threads,
+        );
+    }
+    stats.seconds_trim = t3.elapsed().as_secs_f64();
+    progress.report(1.0, "done")?;
+    stats.output_vertices = mesh.positions.len();
+    stats.output_triangles = mesh.triangles.len();
+    stats.seconds_tree = (t1 - t0).as_secs_f64();
+    stats.seconds_base = (t2 - t1).as_secs_f64();
+    stats.seconds_refine = (t3 - t2).as_secs_f64();
+    Ok((mesh, stats))
+}
+
+/// The grid the base mesh is polygonised on: cells the size of the deepest T-node's cube
+/// (capped at 2^`max_depth` across the root), two cells of margin around the root cube.
+fn polygonisation_grid(tree: &VsTree, max_depth: u32) -> Grid {
+    let deepest = tree
+        .nodes
+        .iter()
+        .filter(|n| n.kind == NodeKind::Transition)
+        .map(|n| u32::from(n.depth))
+        .max()
+        .unwrap_or(0);
+    let depth = deepest.clamp(1, max_depth.min(MAX_GRID_POINTS_PER_AXIS.ilog2() - 1));
+    let root = tree.root();
+    let cells = 1u32 << depth;
+    let cell = 2.0 * root.half / cells as f32;
+    let points = cells + 5;
+    Grid {
+        origin: root.center - root.half - 2.0 * cell,
+        cell,
+        dims: [points; 3],
+    }
+}
+
+/// The grid cells that hold samples: where the surface tracking starts.
+fn sample_cells(grid: &Grid, positions: &[Vec3], threads: &Threads) -> Vec<[u32; 3]> {
+    threads.run(|| {
+        let mut cells: Vec<[u32; 3]> = positions.par_iter().map(|&p| grid.cell_of(p)).collect();
+        cells.par_sort_unstable();
+        cells.dedup();
+        cells
+    })
+}
+
+/// At most `n` of `points`, evenly spread through the slice.
+fn evenly_spread(points: &[Vec3], n: usize) -> Vec<Vec3> {
+    let step = points.len().div_ceil(n.max(1)).max(1);
+    points.iter().step_by(step).copied().collect()
+}
+
+/// error(M, S): RMS and max distance from `points` to the surface, over `diagonal`.
+fn sample_error(
+    s: &refine::Surface,
+    points: &[Vec3],
+    diagonal: f32,
+    threads: &Threads,
+) -> (f64, f64) {
+    let mesh = Mesh {
+        positions: s.positions.clone(),
+        normals: None,
+        triangles: s.triangles.clone(),
+    };
+    let (sum_sq, max) = threads.run(|| {
+        let bvh = TriangleBvh::new(&mesh);
+        points
+            .par_iter()
+            .map(|&p| f64::from(bvh.distance(p)))
+            .fold(|| (0.0, 0.0f64), |(s, m), d| (s + d * d, m.max(d)))
+            .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
+    });
+    let d = f64::from(diagonal).max(f64::MIN_POSITIVE);
+    ((sum_sq / points.len().max(1) as f64).sqrt() / d, max / d)
+}
+
+/// Removes the faces whose centre is farther than `distance` from every sample, then the
+/// vertices no face uses. Returns how many faces went.
+fn trim_far_faces(mesh: &mut Mesh, samples: &PointBvh, distance: f32, threads: &Threads) -> usize {
+    let keep: Vec<bool> = threads.run(|| {
+        mesh.triangles
+            .par_iter()
+            .map(|t| {
+                let centre = t.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / 3.0;
+                samples.distance(centre) <= distance
+            })
+            .collect()
+    });
+    let before = mesh.triangles.len();
+    let mut k = keep.iter();
+    mesh.triangles.retain(|_| *k.next().unwrap_or(&true));
+    let mut index = vec![u32::MAX; mesh.positions.len()];
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    for t in mesh.triangles.iter_mut() {
+        for v in t.iter_mut() {
+            if index[*v as usize] == u32::MAX {
+                index[*v as usize] = positions.len() as u32;
+                positions.push(mesh.positions[*v as usize]);
+                if let Some(n) = &mesh.normals {
+                    normals.push(n[*v as usize]);
+                }
+            }
+            *v = index[*v as usize];
+        }
+    }
+    mesh.normals = mesh.normals.as_ref().map(|_| normals);
+    mesh.positions = positions;
+    before - mesh.triangles.len()
+}

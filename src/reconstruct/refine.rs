@@ -1,0 +1,331 @@
+//! One refinement level (paper §5.2, "Mesh refinement"): every triangle is split 1-to-4; each
+//! new mid-edge vertex starts on the curved PN triangle of its edge (Vlachos et al. 2001), is
+//! then displaced by the quadtree of its T-node, and, where no quadtree leaf is left for it,
+//! smoothed tangentially towards its already final neighbours.
+//!
+//! Displacement: the new vertices of a T-node are dropped down its quadtree together; where a
+//! vertex is alone in an S-node, it moves to the average sample of the unlocked leaf of that
+//! S-node with the highest local variation, and the leaf is locked for good. PN triangles
+//! interpolate their corners, so a displaced vertex stays put in later levels; the locking
+//! keeps two vertices from being pulled onto the same samples (which would alias).
+
+use super::base_mesh::t_node_at;
+use crate::progress::Threads;
+use crate::quadric::CellStats;
+use crate::tree::{NodeKind, VsTree};
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// A mesh being refined: positions, unit normals, and the T-node each vertex belongs to.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Surface {
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub labels: Vec<u32>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// What one level did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LevelStats {
+    pub new_vertices: usize,
+    pub displaced: usize,
+}
+
+/// The quadtrees' leaves, summarised once, and which of them are used up.
+pub(crate) struct Refiner<'t> {
+    tree: &'t VsTree,
+    /// Per leaf below the T-layer: the average sample, the mean normal, the local variation.
+    /// (Unused entries for other nodes.)
+    average: Vec<Vec3>,
+    normal: Vec<Vec3>,
+    variation: Vec<f32>,
+    locked: Vec<AtomicBool>,
+}
+
+impl<'t> Refiner<'t> {
+    pub fn new(tree: &'t VsTree, threads: &Threads) -> Refiner<'t> {
+        let origin = tree.root().center.as_dvec3();
+        let summaries: Vec<(Vec3, Vec3, f32)> = threads.run(|| {
+            tree.nodes
+                .par_iter()
+                .map(|node| {
+                    if !node.is_leaf() || node.kind == NodeKind::Volume {
+                        return (Vec3::ZERO, Vec3::ZERO, 0.0);
+                    }
+                    let mut stats = CellStats::default();
+                    for s in tree.samples_of(node) {
+                        stats.add(s.position.as_dvec3() - origin, s.normal.as_dvec3());
+                    }
+                    // Local variation: the leaf's quadric error, i.e. how far its samples are
+                    // from agreeing on one point's tangent planes.
+                    let variation = stats.l2_error() as f32;
+                    (
+                        (stats.centroid() + origin).as_vec3(),
+                        stats.mean_normal().normalize_or_zero().as_vec3(),
+                        variation,
+                    )
+                })
+                .collect()
+        });
+        let (mut average, mut normal, mut variation) = (Vec::new(), Vec::new(), Vec::new());
+        for (a, n, v) in summaries {
+            average.push(a);
+            normal.push(n);
+            variation.push(v);
+        }
+        let locked = (0..tree.nodes.len())
+            .map(|_| AtomicBool::new(false))
+            .collect();
+        Refiner {
+            tree,
+            average,
+            normal,
+            variation,
+            locked,
+        }
+    }
+
+    /// Splits every triangle of `s` 1-to-4 and places the new vertices.
+    pub fn refine(&self, s: &Surface, threads: &Threads) -> (Surface, LevelStats) {
+        threads.run(|| self.refine_level(s))
+    }
+
+    fn refine_level(&self, s: &Surface) -> (Surface, LevelStats) {
+        let old = s.positions.len() as u32;
+        let mut edges: Vec<(u32, u32)> = s
+            .triangles
+            .par_iter()
+            .flat_map_iter(|t| {
+                (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+            })
+            .collect();
+        edges.par_sort_unstable();
+        edges.dedup();
+        let mid =
+            |a: u32, b: u32| old + edges.binary_search(&(a.min(b), a.max(b))).unwrap_or(0) as u32;
+
+        // New vertices on the PN triangles' edge curves, with PN's quadratic normals.
+        let placed: Vec<(Vec3, Vec3, u32)> = edges
+            .par_iter()
+            .map(|&(a, b)| {
+                let (pa, pb, na, nb) = (
+                    s.positions[a as usize],
+                    s.positions[b as usize],
+                    s.normals[a as usize],
+                    s.normals[b as usize],
+                );
+                let (p, n) = pn_midpoint(pa, na, pb, nb);
+                let label = t_node_at(self.tree, p).unwrap_or(s.labels[a as usize]);
+                (p, n, label)
+            })
+            .collect();
+        let mut out = Surface {
+            positions: s.positions.clone(),
+            normals: s.normals.clone(),
+            labels: s.labels.clone(),
+            triangles: s
+                .triangles
+                .par_iter()
+                .flat_map_iter(|&[a, b, c]| {
+                    let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+                    [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+                })
+                .collect(),
+        };
+        for (p, n, l) in &placed {
+            out.positions.push(*p);
+            out.normals.push(*n);
+            out.labels.push(*l);
+        }
+
+        // Displacement, one T-node's quadtree per task.
+        let mut by_t_node: Vec<(u32, u32)> = placed
+            .iter()
+            .enumerate()
+            .map(|(k, &(_, _, l))| (l, old + k as u32))
+            .collect();
+        by_t_node.par_sort_unstable();
+        let groups: Vec<&[(u32, u32)]> = by_t_node.chunk_by(|a, b| a.0 == b.0).collect();
+        let moves: Vec<(u32, u32)> = groups
+            .par_iter()
+            .flat_map_iter(|group| {
+                let t = group[0].0 as usize;
+                let vertices: Vec<(u32, Vec2)> = group
+                    .iter()
+                    .map(|&(_, v)| (v, self.uv(t, out.positions[v as usize])))
+                    .collect();
+                let mut moves = Vec::new();
+                self.displace(t, vertices, &mut moves);
+                moves
+            })
+            .collect();
+        let mut displaced = vec![false; out.positions.len()];
+        for &(v, leaf) in &moves {
+            out.positions[v as usize] = self.average[leaf as usize];
+            if self.normal[leaf as usize] != Vec3::ZERO {
+                out.normals[v as usize] = self.normal[leaf as usize];
+            }
+            displaced[v as usize] = true;
+        }
+
+        smooth_tangentially(&mut out, old, &displaced);
+        (
+            out,
+            LevelStats {
+                new_vertices: placed.len(),
+                displaced: moves.len(),
+            },
+        )
+    }
+
+    /// Coordinates of `p` in the plane of T-node `t`.
+    fn uv(&self, t: usize, p: Vec3) -> Vec2 {
+        self.tree.frames[self.tree.nodes[t].frame as usize].project(p)
+    }
+
+    /// Sends `vertices` (with their plane coordinates) down the quadtree from node `i`, and
+    /// records (vertex, leaf) for each vertex that ends up alone in a node with a free leaf.
+    fn displace(&self, i: usize, vertices: Vec<(u32, Vec2)>, moves: &mut Vec<(u32, u32)>) {
+        let node = &self.tree.nodes[i];
+        let (center, half) = if node.kind == NodeKind::Transition {
+            let f = &self.tree.frames[node.frame as usize];
+            (f.square_center, f.square_half)
+        } else {
+            (node.center_uv(), node.half)
+        };
+        let inside: Vec<(u32, Vec2)> = vertices
+            .into_iter()
+            .filter(|(_, uv)| (*uv - center).abs().max_element() <= half)
+            .collect();
+        match inside.len() {
+            0 => {}
+            1 => {
+                if let Some(leaf) = self.take_leaf(i, inside[0].1) {
+                    moves.push((inside[0].0, leaf));
+                }
+            }
+            _ if node.is_leaf() => {} // several vertices share one leaf: none is displaced
+            _ => {
+                for child in node.children() {
+                    let slot = self.tree.nodes[child].slot;
+                    let mine: Vec<(u32, Vec2)> = inside
+                        .iter()
+                        .copied()
+                        .filter(|(_, uv)| {
+                            ((uv.x >= center.x) as u8 | ((uv.y >= center.y) as u8) << 1) == slot
+                        })
+                        .collect();
+                    if !mine.is_empty() {
+                        self.displace(child, mine, moves);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The unlocked leaf below node `i` with the highest variation (ties: the one nearest to
+    /// `uv`), locked before it is returned.
+    fn take_leaf(&self, i: usize, uv: Vec2) -> Option<u32> {
+        let mut best: Option<(f32, f32, usize)> = None;
+        let mut stack = vec![i];
+        while let Some(n) = stack.pop() {
+            let node = &self.tree.nodes[n];
+            if !node.is_leaf() {
+                stack.extend(node.children());
+                continue;
+            }
+            if self.locked[n].load(Ordering::Relaxed) {
+                continue;
+            }
+            let distance = (self.uv_of_leaf(n) - uv).length_squared();
+            let candidate = (self.variation[n], -distance, n);
+            if best.is_none_or(|b| (candidate.0, candidate.1) > (b.0, b.1)) {
+                best = Some(candidate);
+            }
+        }
+        let (_, _, leaf) = best?;
+        self.locked[leaf].store(true, Ordering::Relaxed);
+        Some(leaf as u32)
+    }
+
+    fn uv_of_leaf(&self, n: usize) -> Vec2 {
+        let node = &self.tree.nodes[n];
+        if node.kind == NodeKind::Surface {
+            node.center_uv()
+        } else {
+            self.tree.frames[node.frame as usize].square_center
+        }
+    }
+}
+
+/// The midpoint of a PN triangle's edge curve from (`pa`, `na`) to (`pb`, `nb`), and the PN
+/// quadratic normal there. The edge's cubic Bézier control points are the ends moved a third of
+/// the way along the edge and projected onto the end's tangent plane; the curve (and so the
+/// point) is the same for both triangles sharing the edge.
+pub(crate) fn pn_midpoint(pa: Vec3, na: Vec3, pb: Vec3, nb: Vec3) -> (Vec3, Vec3) {
+    let e = pb - pa;
+    let b1 = (2.0 * pa + pb - e.dot(na) * na) / 3.0;
+    let b2 = (2.0 * pb + pa + e.dot(nb) * nb) / 3.0;
+    let p = (pa + 3.0 * b1 + 3.0 * b2 + pb) / 8.0;
+    // Quadratic normal: the average, reflected across the plane normal to the edge.
+    let len2 = e.length_squared();
+    let v = if len2 > 0.0 {
+        2.0 * e.dot(na + nb) / len2
+    } else {
+        0.0
+    };
+    let n110 = (na + nb - v * e).normalize_or_zero();
+    let n = (0.25 * (na + nb) + 0.5 * n110).normalize_or_zero();
+    (p, if n == Vec3::ZERO { na } else { n })
+}
+
+/// Moves each new vertex that was not displaced towards the mean of its neighbours that are
+/// final (old vertices and displaced ones), within its tangent plane only. Each new vertex has
+/// at least its edge's two ends as final neighbours.
+fn smooth_tangentially(s: &mut Surface, first_new: u32, displaced: &[bool]) {
+    let is_final = |v: u32| v < first_new || displaced[v as usize];
+    let mut sum = vec![Vec3::ZERO; s.positions.len()];
+    let mut count = vec![0u32; s.positions.len()];
+    for t in &s.triangles {
+        for k in 0..3 {
+            for (x, y) in [(t[k], t[(k + 1) % 3]), (t[(k + 1) % 3], t[k])] {
+                if !is_final(x) && is_final(y) {
+                    sum[x as usize] += s.positions[y as usize];
+                    count[x as usize] += 1;
+                }
+            }
+        }
+    }
+    for v in first_new as usize..s.positions.len() {
+        if !displaced[v] && count[v] > 0 {
+            let n = s.normals[v];
+            let delta = sum[v] / count[v] as f32 - s.positions[v];
+            s.positions[v] += delta - n * n.dot(delta);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pn_midpoint_of_an_arc_bulges_onto_the_circle() {
+        // Two points on the unit circle 90 degrees apart, with radial normals.
+        let (a, b) = (Vec3::X, Vec3::Y);
+        let (p, n) = pn_midpoint(a, a, b, b);
+        let chord = 0.5 * (a + b);
+        assert!(p.length() > chord.length() + 0.2, "no bulge: {p}");
+        assert!(
+            (p.length() - 1.0).abs() < 0.02,
+            "{p} is off the circle by {}",
+            p.length() - 1.0
+        );
+        assert!((n - Vec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-5);
+        // Flat: the midpoint of the chord.
+        let (p, _) = pn_midpoint(Vec3::ZERO, Vec3::Z, Vec3::X, Vec3::Z);
+        assert!((p - Vec3::new(0.5, 0.0, 0.0)).length() < 1e-6);
+    }
+}
