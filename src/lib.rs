@@ -8,6 +8,7 @@
 pub mod distance;
 pub mod error;
 pub mod io;
+pub mod knn;
 mod linalg;
 pub mod mesh;
 pub mod progress;
