@@ -11,6 +11,7 @@ pub mod io;
 pub mod knn;
 mod linalg;
 pub mod mesh;
+pub mod normals;
 pub mod progress;
 pub mod quadric;
 pub mod rng;
