@@ -161,6 +161,28 @@ fn propagation_repairs_randomly_flipped_normals() {
 }
 
 #[test]
+fn separate_components_are_each_turned_outward() {
+    // Two spheres and a torus far apart: three components, each oriented on its own.
+    let mut points = Vec::new();
+    let mut truth = Vec::new();
+    for (centre, seed) in [(Vec3::X * -4.0, 20), (Vec3::X * 4.0, 21)] {
+        let cloud = sphere_cloud(6_000, seed);
+        points.extend(cloud.positions.iter().map(|p| *p + centre));
+        truth.extend(sphere_truth(&cloud.positions));
+    }
+    let ring = sample_surface(&torus(1.0, 0.3, 128, 48), 8_000, 22);
+    points.extend(ring.positions.iter().map(|p| *p + Vec3::Y * 5.0));
+    truth.extend(ring.normals.unwrap());
+    let mut cloud = Mesh::from_points(points, None);
+    let report =
+        ensure_normals(&mut cloud, &NormalParams::default(), &mut Progress::none()).unwrap();
+    let side = agreeing(cloud.normals.as_ref().unwrap(), &truth);
+    println!("three shapes: {:.2}% outward, {report:?}", 100.0 * side);
+    assert_eq!(report.orient.unwrap().components, 3);
+    assert_eq!(side, 1.0);
+}
+
+#[test]
 fn same_normals_for_one_and_two_threads() {
     let mut cloud = sample_surface(&torus(1.0, 0.3, 128, 48), 30_000, 8);
     add_noise(&mut cloud, 0.003, 0.0, 9);
