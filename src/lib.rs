@@ -8,8 +8,10 @@
 pub mod distance;
 pub mod error;
 pub mod io;
+pub mod knn;
 mod linalg;
 pub mod mesh;
+pub mod normals;
 mod polygonize;
 pub mod progress;
 pub mod quadric;

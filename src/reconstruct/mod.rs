@@ -246,7 +246,7 @@ pub fn reconstruct(
     if params.trim > 0.0 {
         stats.trimmed_triangles = trim_far_faces(
             &mut mesh,
-            &samples.positions,
+            &near,
             params.trim * grid.cell,
             &threads,
         );
