@@ -45,9 +45,14 @@ impl Build {
     }
 }
 
+/// A timed sample should last at least this long: faster builds are repeated within one sample
+/// (and the time divided), so timer resolution and scheduler ticks do not dominate.
+const MIN_SAMPLE_SECONDS: f64 = 0.02;
+
 /// Builds the octree and the VS-Tree `runs` times each, interleaved (and alternating which goes
 /// first) so load changes on the machine hit both alike. With `warm_up`, one untimed build of
-/// each comes first. Returns `[octree, vstree]`.
+/// each comes first, and builds faster than [`MIN_SAMPLE_SECONDS`] are repeated within each
+/// timed sample. Returns `[octree, vstree]`.
 pub fn builds(
     samples: &SampleSet,
     bound: f64,
@@ -57,25 +62,36 @@ pub fn builds(
 ) -> vstree::Result<[Build; 2]> {
     let mut times = [Vec::new(), Vec::new()];
     let mut stats = [TreeStats::default(); 2];
-    let build = |k: usize| -> vstree::Result<(f64, TreeStats)> {
-        let start = Instant::now();
-        let tree = tree::build(
-            samples,
-            &params(KINDS[k], bound),
-            threads,
-            &mut Progress::none(),
-        )?;
-        let seconds = start.elapsed().as_secs_f64();
-        Ok((seconds, tree.stats())) // the tree is dropped outside the timed span
+    // Mean seconds of `repeat` builds of kind `k`, and the tree's figures.
+    let build = |k: usize, repeat: usize| -> vstree::Result<(f64, TreeStats)> {
+        let mut total = 0.0;
+        let mut figures = TreeStats::default();
+        for _ in 0..repeat {
+            let start = Instant::now();
+            let tree = tree::build(
+                samples,
+                &params(KINDS[k], bound),
+                threads,
+                &mut Progress::none(),
+            )?;
+            total += start.elapsed().as_secs_f64();
+            figures = tree.stats(); // the tree is dropped outside the timed span
+        }
+        Ok((total / repeat as f64, figures))
     };
+    let mut repeat = [1, 1];
     if warm_up {
-        build(0)?;
-        build(1)?;
+        for (k, r) in repeat.iter_mut().enumerate() {
+            let (seconds, _) = build(k, 1)?;
+            *r = (MIN_SAMPLE_SECONDS / seconds.max(1e-6))
+                .ceil()
+                .clamp(1.0, 1000.0) as usize;
+        }
     }
     for run in 0..runs.max(1) {
         for step in 0..2 {
             let k = if run % 2 == 0 { step } else { 1 - step };
-            let (seconds, s) = build(k)?;
+            let (seconds, s) = build(k, repeat[k])?;
             times[k].push(seconds);
             stats[k] = s;
         }
