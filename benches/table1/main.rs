@@ -196,7 +196,9 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
         methods.append(&mut m);
     }
 
+    let mut one_thread = Vec::new();
     let (surface_name, surface) = inputs::cloud_surface(&o.data);
+    let largest = o.big.iter().copied().max();
     for &count in &o.big {
         eprintln!("table1: {count} samples on {surface_name}");
         let input = Input {
@@ -207,6 +209,20 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
         };
         let (mut r, _) = mesh_rows(&input, o, &threads)?;
         rows.append(&mut r);
+        if Some(count) == largest && o.threads != 1 {
+            eprintln!("table1: {count} samples on one thread");
+            let single = Threads::new(1)?;
+            for &bound in &o.bounds {
+                one_thread.push(Row {
+                    input: input.name.clone(),
+                    samples: count,
+                    bound,
+                    builds: measure::builds(&input.samples, bound, &single, o.big_runs, false)?,
+                    triangles: None,
+                    distances: None,
+                });
+            }
+        }
     }
     drop(surface);
 
@@ -227,6 +243,7 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
 
     Ok(Report {
         rows,
+        one_thread,
         methods,
         memory,
         context: Context {

@@ -4,7 +4,7 @@ use glam::Vec3;
 use std::time::Instant;
 use vstree::distance::{one_sided, Target};
 use vstree::shapes::sample_surface;
-use vstree::tree::{self, TreeKind, TreeParams, TreeStats};
+use vstree::tree::{self, NodeKind, TreeKind, TreeParams, TreeStats, VsTree};
 use vstree::{simplify, Mesh, MeshSampling, Progress, SampleSet, SimplifyParams, Threads};
 
 /// The two hierarchies, in the order the table shows them.
@@ -36,6 +36,8 @@ pub struct Build {
     /// Median wall time of the builds, in seconds.
     pub seconds: f64,
     pub stats: TreeStats,
+    /// Leaves that are S-nodes: clusters cut by a quadtree in a T-node's plane.
+    pub surface_leaves: usize,
 }
 
 impl Build {
@@ -43,6 +45,21 @@ impl Build {
     pub fn spread(&self) -> f64 {
         self.stats.leaf_size_variance / self.stats.leaf_size_mean.powi(2)
     }
+
+    /// Share of the clusters that are S-nodes.
+    pub fn surface_share(&self) -> f64 {
+        self.surface_leaves as f64 / self.stats.leaves.max(1) as f64
+    }
+}
+
+/// The tree's figures, and how many of its leaves are S-nodes.
+fn figures(tree: &VsTree) -> (TreeStats, usize) {
+    let surface = tree
+        .nodes
+        .iter()
+        .filter(|n| n.is_leaf() && n.kind == NodeKind::Surface)
+        .count();
+    (tree.stats(), surface)
 }
 
 /// A timed sample should last at least this long: faster builds are repeated within one sample
@@ -61,11 +78,11 @@ pub fn builds(
     warm_up: bool,
 ) -> vstree::Result<[Build; 2]> {
     let mut times = [Vec::new(), Vec::new()];
-    let mut stats = [TreeStats::default(); 2];
+    let mut stats = [(TreeStats::default(), 0); 2];
     // Mean seconds of `repeat` builds of kind `k`, and the tree's figures.
-    let build = |k: usize, repeat: usize| -> vstree::Result<(f64, TreeStats)> {
+    let build = |k: usize, repeat: usize| -> vstree::Result<(f64, (TreeStats, usize))> {
         let mut total = 0.0;
-        let mut figures = TreeStats::default();
+        let mut last = (TreeStats::default(), 0);
         for _ in 0..repeat {
             let start = Instant::now();
             let tree = tree::build(
@@ -75,9 +92,9 @@ pub fn builds(
                 &mut Progress::none(),
             )?;
             total += start.elapsed().as_secs_f64();
-            figures = tree.stats(); // the tree is dropped outside the timed span
+            last = figures(&tree); // the tree is dropped outside the timed span
         }
-        Ok((total / repeat as f64, figures))
+        Ok((total / repeat as f64, last))
     };
     let mut repeat = [1, 1];
     if warm_up {
@@ -98,7 +115,8 @@ pub fn builds(
     }
     Ok([0, 1].map(|k| Build {
         seconds: median(&times[k]),
-        stats: stats[k],
+        stats: stats[k].0,
+        surface_leaves: stats[k].1,
     }))
 }
 
