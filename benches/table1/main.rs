@@ -29,7 +29,7 @@ usage: cargo bench --bench table1 -- [options]
   --peers            also run PyMeshLab's clustering and quadric edge collapse (benches/peers.py)
   --runs N           timed runs per measurement (default 5)
   --big-runs N       timed runs for inputs of 1M samples or more (default 3)
-  --big A,B          sizes of the clouds drawn on a surface (default 1000000,5000000; none: no cloud)
+  --big A,B          sizes of the clouds drawn on a surface (default 1000000,5000000; or none)
   --bounds A,B       L2 bounds (default 1e-4,2e-3)
   --models A,B       only these models of the data directory (file stems)
   --data DIR         data directory (default ../shared/data, relative to the project root)

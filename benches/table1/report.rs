@@ -305,8 +305,9 @@ impl Report {
             "### Clusters and simplified output\n\n\
              Spread = variance / mean² of the samples per cluster (the paper: the variance \
              roughly halves). S-leaves = share of the VS-Tree's clusters that are quadtree \
-             cells (S-nodes); the others are cubes (V- or T-node leaves), where the height-field test \
-             failed or passed only once the bound was met. Output = triangles of the simplified mesh (clouds have none). \
+             cells (S-nodes); the others are cubes (V- or T-node leaves), where the \
+             height-field test failed or passed only once the bound was met. Output = \
+             triangles of the simplified mesh (clouds have none). \
              Distance = VS-Tree output to the input, mean / max relative to the input's \
              bounding-box diagonal, from 200k points on the output's surface to the input's \
              triangles.\n\n\
