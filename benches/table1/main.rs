@@ -86,7 +86,6 @@ impl Options {
                 "--bounds" => o.bounds = list(value()?)?,
                 "--models" => o.models = Some(v_split(value()?)),
                 "--data" => o.data = PathBuf::from(value()?),
-                "--help" | "-h" => return Err(USAGE.into()),
                 other => return Err(format!("unknown option {other}\n{USAGE}")),
             }
         }
@@ -116,6 +115,10 @@ fn main() {
         .filter(|a| a != "--bench")
         .collect();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        println!("{USAGE}");
+        return;
+    }
     if args.first().map(String::as_str) == Some("--memory-child") {
         memory_child(&args[1..], &root);
         return;
