@@ -1,0 +1,121 @@
+//! The benchmark's inputs: every mesh with triangles in the data directory (sampled at its
+//! vertices), and dense clouds drawn on a mesh surface.
+
+use glam::Vec3;
+use std::path::{Path, PathBuf};
+use vstree::{io, shapes, Mesh, MeshSampling, SampleSet};
+
+/// One input of the table.
+pub struct Input {
+    /// Short name: the file stem, or e.g. `igea 5M` for a generated cloud.
+    pub name: String,
+    /// The source file, for meshes read from the data directory.
+    pub path: Option<PathBuf>,
+    /// The mesh, for inputs with triangles (generated clouds have none).
+    pub mesh: Option<Mesh>,
+    pub samples: SampleSet,
+}
+
+/// Extensions `vstree::io` reads.
+const EXTENSIONS: [&str; 5] = ["ply", "obj", "off", "xyz", "pwn"];
+
+/// The meshes (inputs with triangles) in `data`, ordered by sample count, optionally only those
+/// whose stem is in `only`. Files that fail to read are reported and skipped.
+pub fn models(data: &Path, only: Option<&[String]>) -> Vec<Input> {
+    let Ok(entries) = std::fs::read_dir(data) else {
+        eprintln!(
+            "table1: {} is absent: only generated inputs will run",
+            data.display()
+        );
+        return Vec::new();
+    };
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.extension()
+                .and_then(|e| e.to_str())
+                .is_some_and(|e| EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
+        })
+        .filter(|p| only.map_or(true, |names| names.iter().any(|n| *n == stem(p))))
+        .collect();
+    paths.sort();
+    let mut inputs: Vec<Input> = paths.iter().filter_map(|p| model(p)).collect();
+    inputs.sort_by_key(|i| i.samples.len());
+    inputs
+}
+
+fn stem(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// The mesh at `path` with its vertex samples, or `None` for point clouds and unreadable files.
+fn model(path: &Path) -> Option<Input> {
+    let mesh = match io::read(path) {
+        Ok(mesh) => mesh,
+        Err(e) => {
+            eprintln!("table1: skipping {}: {e}", path.display());
+            return None;
+        }
+    };
+    if mesh.is_point_cloud() {
+        return None;
+    }
+    let samples = match SampleSet::from_mesh(&mesh, MeshSampling::Vertices) {
+        Ok(samples) => samples,
+        Err(e) => {
+            eprintln!("table1: skipping {}: {e}", path.display());
+            return None;
+        }
+    };
+    Some(Input {
+        name: stem(path),
+        path: Some(path.to_path_buf()),
+        mesh: Some(mesh),
+        samples,
+    })
+}
+
+/// The surface dense clouds are drawn on: igea (a model of the paper) with smooth vertex
+/// normals, or a bumpy sphere when the data directory is absent. Returns its name too.
+pub fn cloud_surface(data: &Path) -> (String, Mesh) {
+    let igea = data.join("igea.ply");
+    if let Ok(mut mesh) = io::read(&igea) {
+        if let Ok(samples) = SampleSet::from_mesh(&mesh, MeshSampling::Vertices) {
+            // Area-weighted vertex normals, so sampled normals vary smoothly like a scan's.
+            let mut normals = vec![Vec3::ZERO; mesh.positions.len()];
+            for (&v, &n) in samples.origin.iter().zip(&samples.normals) {
+                normals[v as usize] = n;
+            }
+            mesh.normals = Some(normals);
+            return ("igea".into(), mesh);
+        }
+    }
+    (
+        "bumpy sphere".into(),
+        shapes::bumpy_sphere(1.0, 0.2, 6.0, 7),
+    )
+}
+
+/// `count` samples drawn uniformly by area on `surface` (fixed seed), with their normals.
+pub fn cloud(surface: &Mesh, count: usize) -> SampleSet {
+    let cloud = shapes::sample_surface(surface, count, 2006);
+    // `sample_surface` already gives unit normals: move them instead of copying.
+    let normals = cloud.normals.unwrap_or_default();
+    SampleSet {
+        origin: (0..cloud.positions.len() as u32).collect(),
+        positions: cloud.positions,
+        normals,
+    }
+}
+
+/// `1000000` as `1M`, `1500` as `1.5k`.
+pub fn short_count(n: usize) -> String {
+    match n {
+        n if n >= 1_000_000 && n % 1_000_000 == 0 => format!("{}M", n / 1_000_000),
+        n if n >= 1_000_000 => format!("{:.1}M", n as f64 / 1e6),
+        n if n >= 1_000 && n % 1_000 == 0 => format!("{}k", n / 1_000),
+        n => n.to_string(),
+    }
+}

@@ -1,0 +1,190 @@
+//! Timings and figures: tree builds, simplifications, and distances to the input.
+
+use glam::Vec3;
+use std::time::Instant;
+use vstree::distance::{one_sided, Target};
+use vstree::shapes::sample_surface;
+use vstree::tree::{self, NodeKind, TreeKind, TreeParams, TreeStats, VsTree};
+use vstree::{simplify, Mesh, MeshSampling, Progress, SampleSet, SimplifyParams, Threads};
+
+/// The two hierarchies, in the order the table shows them.
+pub const KINDS: [TreeKind; 2] = [TreeKind::Octree, TreeKind::VsTree];
+
+/// Tree parameters: the paper's defaults with the L2 metric at `bound`.
+pub fn params(kind: TreeKind, bound: f64) -> TreeParams {
+    TreeParams {
+        kind,
+        error: bound,
+        ..TreeParams::default()
+    }
+}
+
+/// The median of `values` (mean of the two middle ones for an even count; 0 when empty).
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => 0.0,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+/// One tree kind's build on one input at one bound.
+#[derive(Clone, Copy, Debug)]
+pub struct Build {
+    /// Median wall time of the builds, in seconds.
+    pub seconds: f64,
+    pub stats: TreeStats,
+    /// Leaves that are S-nodes: clusters cut by a quadtree in a T-node's plane.
+    pub surface_leaves: usize,
+}
+
+impl Build {
+    /// Variance of the samples per cluster over the squared mean (scale-free spread).
+    pub fn spread(&self) -> f64 {
+        self.stats.leaf_size_variance / self.stats.leaf_size_mean.powi(2)
+    }
+
+    /// Share of the clusters that are S-nodes.
+    pub fn surface_share(&self) -> f64 {
+        self.surface_leaves as f64 / self.stats.leaves.max(1) as f64
+    }
+}
+
+/// The tree's figures, and how many of its leaves are S-nodes.
+fn figures(tree: &VsTree) -> (TreeStats, usize) {
+    let surface = tree
+        .nodes
+        .iter()
+        .filter(|n| n.is_leaf() && n.kind == NodeKind::Surface)
+        .count();
+    (tree.stats(), surface)
+}
+
+/// A timed sample should last at least this long: faster builds are repeated within one sample
+/// (and the time divided), so timer resolution and scheduler ticks do not dominate.
+const MIN_SAMPLE_SECONDS: f64 = 0.02;
+
+/// Builds the octree and the VS-Tree `runs` times each, interleaved (and alternating which goes
+/// first) so load changes on the machine hit both alike. With `warm_up`, one untimed build of
+/// each comes first, and builds faster than [`MIN_SAMPLE_SECONDS`] are repeated within each
+/// timed sample. Returns `[octree, vstree]`.
+pub fn builds(
+    samples: &SampleSet,
+    bound: f64,
+    threads: &Threads,
+    runs: usize,
+    warm_up: bool,
+) -> vstree::Result<[Build; 2]> {
+    let mut times = [Vec::new(), Vec::new()];
+    let mut stats = [(TreeStats::default(), 0); 2];
+    // Mean seconds of `repeat` builds of kind `k`, and the tree's figures.
+    let build = |k: usize, repeat: usize| -> vstree::Result<(f64, (TreeStats, usize))> {
+        let mut total = 0.0;
+        let mut last = (TreeStats::default(), 0);
+        for _ in 0..repeat {
+            let start = Instant::now();
+            let tree = tree::build(
+                samples,
+                &params(KINDS[k], bound),
+                threads,
+                &mut Progress::none(),
+            )?;
+            total += start.elapsed().as_secs_f64();
+            last = figures(&tree); // the tree is dropped outside the timed span
+        }
+        Ok((total / repeat as f64, last))
+    };
+    let mut repeat = [1, 1];
+    if warm_up {
+        for (k, r) in repeat.iter_mut().enumerate() {
+            let (seconds, _) = build(k, 1)?;
+            *r = (MIN_SAMPLE_SECONDS / seconds.max(1e-6))
+                .ceil()
+                .clamp(1.0, 1000.0) as usize;
+        }
+    }
+    for run in 0..runs.max(1) {
+        for step in 0..2 {
+            let k = if run % 2 == 0 { step } else { 1 - step };
+            let (seconds, s) = build(k, repeat[k])?;
+            times[k].push(seconds);
+            stats[k] = s;
+        }
+    }
+    Ok([0, 1].map(|k| Build {
+        seconds: median(&times[k]),
+        stats: stats[k].0,
+        surface_leaves: stats[k].1,
+    }))
+}
+
+/// A simplified mesh and the median time it took.
+pub struct Simplified {
+    pub mesh: Mesh,
+    pub seconds: f64,
+}
+
+/// Simplifies `mesh` with vertex samples `runs` times (the whole call: samples, tree,
+/// clustering) on `threads` threads (0 = all); the median time and the last output.
+pub fn simplified(
+    mesh: &Mesh,
+    kind: TreeKind,
+    bound: f64,
+    threads: usize,
+    runs: usize,
+) -> vstree::Result<Simplified> {
+    let params = SimplifyParams {
+        tree: params(kind, bound),
+        sampling: MeshSampling::Vertices,
+        threads,
+    };
+    let mut times = Vec::new();
+    let mut out = Mesh::default();
+    for _ in 0..runs.max(1) {
+        let start = Instant::now();
+        let (mesh, _) = simplify(mesh, &params, &mut Progress::none())?;
+        times.push(start.elapsed().as_secs_f64());
+        out = mesh;
+    }
+    Ok(Simplified {
+        mesh: out,
+        seconds: median(&times),
+    })
+}
+
+/// Points sampled on a simplified surface to measure its distance to the input.
+const SURFACE_SAMPLES: usize = 200_000;
+
+/// Distances between a simplified mesh and its input, relative to the input's bounding-box
+/// diagonal. `None` where a side is empty.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Distances {
+    /// From [`SURFACE_SAMPLES`] points uniform on the output's surface to the input's triangles.
+    pub out_in: Option<(f64, f64)>,
+    /// From the input's samples (its used vertices) to the output's triangles: catches what the
+    /// output lost (holes, thin parts).
+    pub in_out: Option<(f64, f64)>,
+}
+
+/// [`Distances`] of `output` to `input` (whose samples are `input_points`, box diagonal
+/// `diagonal`), with `vstree::distance`.
+pub fn distances(input: &Mesh, input_points: &[Vec3], diagonal: f32, output: &Mesh) -> Distances {
+    let relative = |from: &[Vec3], to: Target| {
+        let s = one_sided(from, to);
+        (s.count > 0 && s.max.is_finite()).then(|| {
+            let d = f64::from(diagonal);
+            (f64::from(s.mean) / d, f64::from(s.max) / d)
+        })
+    };
+    let on_output = sample_surface(output, SURFACE_SAMPLES, 31).positions;
+    Distances {
+        out_in: relative(&on_output, Target::Triangles(input)),
+        in_out: if output.triangles.is_empty() {
+            None
+        } else {
+            relative(input_points, Target::Triangles(output))
+        },
+    }
+}

@@ -1,0 +1,525 @@
+//! The Markdown report: machine, tables, targets; and its place in `docs/benchmarks.md`.
+
+use crate::inputs::short_count;
+use crate::measure::{Build, Distances};
+use crate::memory::Memory;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::{SystemTime, UNIX_EPOCH};
+use vstree::TreeKind;
+
+pub const BEGIN: &str = "<!-- table1:begin -->";
+pub const END: &str = "<!-- table1:end -->";
+
+/// Targets of issue 2.
+const GAIN_TARGET: f64 = 0.18;
+const BIG_SECONDS_TARGET: f64 = 2.0;
+const BYTES_TARGET: f64 = 150.0;
+
+/// Table 1 row: one input at one bound.
+pub struct Row {
+    pub input: String,
+    pub samples: usize,
+    pub bound: f64,
+    /// `[octree, vstree]`.
+    pub builds: [Build; 2],
+    /// Output triangles of the `[octree, vstree]` simplifications (meshes only).
+    pub triangles: Option<[usize; 2]>,
+    /// Distances of the VS-Tree's simplified mesh to the input (meshes only).
+    pub distances: Option<Distances>,
+}
+
+impl Row {
+    /// 1 − VS-Tree clusters / octree clusters.
+    pub fn gain(&self) -> f64 {
+        1.0 - self.builds[1].stats.leaves as f64 / self.builds[0].stats.leaves as f64
+    }
+
+    /// VS-Tree build time / octree build time.
+    pub fn time_ratio(&self) -> f64 {
+        self.builds[1].seconds / self.builds[0].seconds
+    }
+
+    pub fn spread_ratio(&self) -> f64 {
+        self.builds[1].spread() / self.builds[0].spread()
+    }
+}
+
+/// One simplification of one input at one bound, by one method.
+pub struct Method {
+    pub input: String,
+    pub bound: f64,
+    pub method: String,
+    pub triangles: usize,
+    /// Median seconds with all threads; for vstree also with one thread.
+    pub seconds: f64,
+    pub seconds_one_thread: Option<f64>,
+    pub note: String,
+    pub distances: Distances,
+}
+
+/// Where and how the run happened.
+pub struct Context {
+    pub command: String,
+    pub runs: usize,
+    pub big_runs: usize,
+    pub threads: usize,
+    pub load_start: String,
+    pub load_end: String,
+    pub seconds: f64,
+    pub cloud_surface: String,
+    pub notes: Vec<String>,
+}
+
+/// Everything one run measured.
+pub struct Report {
+    pub rows: Vec<Row>,
+    /// Builds of the largest cloud on one thread (same inputs and bounds as in `rows`).
+    pub one_thread: Vec<Row>,
+    pub methods: Vec<Method>,
+    pub memory: Vec<Memory>,
+    pub context: Context,
+}
+
+/// The load averages (1, 5, 15 minutes) from `/proc/loadavg`.
+pub fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
+}
+
+/// Processor, core count, memory, kernel, compiler and today's date (UTC).
+fn machine() -> String {
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let field = |text: &str, key: &str| {
+        text.lines()
+            .find(|l| l.starts_with(key))
+            .and_then(|l| l.split(':').nth(1))
+            .map(|v| v.trim().to_string())
+    };
+    let cpu = field(&cpuinfo, "model name").unwrap_or_else(|| "unknown CPU".into());
+    let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();
+    let memory = field(&meminfo, "MemTotal")
+        .and_then(|v| v.trim_end_matches("kB").trim().parse::<f64>().ok())
+        .map_or("unknown memory".into(), |kb| {
+            format!("{:.1} GiB RAM", kb / 1024.0 / 1024.0)
+        });
+    let kernel = std::fs::read_to_string("/proc/sys/kernel/osrelease")
+        .map_or("unknown".into(), |s| s.trim().to_string());
+    let rustc = std::process::Command::new(std::env::var("RUSTC").unwrap_or("rustc".into()))
+        .arg("--version")
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "rustc unknown".into());
+    format!(
+        "{cpus} logical CPUs (`nproc`), {cpu}, {memory}, Linux {kernel}, {rustc}, {}",
+        today()
+    )
+}
+
+/// Today's date (UTC) as YYYY-MM-DD, from the civil-from-days algorithm (H. Hinnant).
+fn today() -> String {
+    let secs = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs()) as i64;
+    let z = secs.div_euclid(86_400) + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02}")
+}
+
+/// Seconds shown as milliseconds with about three significant digits.
+fn ms(s: f64) -> String {
+    let ms = 1000.0 * s;
+    if ms >= 100.0 {
+        format!("{ms:.0}")
+    } else if ms >= 10.0 {
+        format!("{ms:.1}")
+    } else if ms >= 1.0 {
+        format!("{ms:.2}")
+    } else {
+        format!("{ms:.3}")
+    }
+}
+
+fn seconds(s: f64) -> String {
+    if s >= 10.0 {
+        format!("{s:.1}")
+    } else {
+        format!("{s:.2}")
+    }
+}
+
+fn percent(x: f64) -> String {
+    format!("{:.1}%", 100.0 * x)
+}
+
+/// A distance relative to the diagonal, as a percentage with three significant digits.
+fn relative(x: f64) -> String {
+    let p = 100.0 * x;
+    let decimals = if p == 0.0 {
+        3
+    } else {
+        (2 - p.abs().log10().floor() as i32).clamp(0, 5) as usize
+    };
+    format!("{p:.decimals$}%")
+}
+
+fn mean_max(d: Option<(f64, f64)>) -> String {
+    d.map_or("—".into(), |(mean, max)| {
+        format!("{} / {}", relative(mean), relative(max))
+    })
+}
+
+fn bound(b: f64) -> String {
+    format!("{b:.0e}")
+}
+
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+fn kind_name(kind: TreeKind) -> &'static str {
+    match kind {
+        TreeKind::Octree => "octree",
+        TreeKind::VsTree => "VS-Tree",
+    }
+}
+
+impl Report {
+    /// The whole generated block, without the markers.
+    pub fn markdown(&self) -> String {
+        let mut md = String::new();
+        let c = &self.context;
+        let _ = writeln!(md, "Generated by `{}`.\n", c.command);
+        let _ = writeln!(md, "- Machine: {}.", machine());
+        let _ = writeln!(
+            md,
+            "- Load average (1/5/15 min) at start: {}; at end: {}. Whole run: {} s.",
+            c.load_start,
+            c.load_end,
+            seconds(c.seconds)
+        );
+        let threads = if c.threads == 0 {
+            "all cores".to_string()
+        } else {
+            c.threads.to_string()
+        };
+        let _ = writeln!(
+            md,
+            "- Times are medians of {} runs ({} for inputs of 1M samples or more), octree and \
+             VS-Tree builds interleaved; threads: {threads}. Dense clouds are drawn on {}.",
+            c.runs, c.big_runs, c.cloud_surface
+        );
+        for note in &c.notes {
+            let _ = writeln!(md, "- {note}");
+        }
+        md.push('\n');
+        self.targets(&mut md);
+        self.table1(&mut md);
+        self.scaling(&mut md);
+        self.clusters(&mut md);
+        self.simplification(&mut md);
+        self.memory_table(&mut md);
+        md
+    }
+
+    fn table1(&self, md: &mut String) {
+        md.push_str(
+            "### Table 1: build time and clusters at the same L2 bound\n\n\
+             | input | samples | L2 bound | octree build (ms) | VS-Tree build (ms) | VS/oct time \
+             | octree clusters | VS-Tree clusters | gain |\n\
+             |---|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+        );
+        for r in &self.rows {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {:.2} | {} | {} | {} |",
+                r.input,
+                thousands(r.samples),
+                bound(r.bound),
+                ms(r.builds[0].seconds),
+                ms(r.builds[1].seconds),
+                r.time_ratio(),
+                thousands(r.builds[0].stats.leaves),
+                thousands(r.builds[1].stats.leaves),
+                percent(r.gain())
+            );
+        }
+        md.push('\n');
+    }
+
+    fn scaling(&self, md: &mut String) {
+        if self.one_thread.is_empty() {
+            return;
+        }
+        md.push_str(
+            "### Threads: the largest cloud on one thread and on all\n\n\
+             | input | L2 bound | octree, 1 thread (ms) | octree, all (ms) | speed-up \
+             | VS-Tree, 1 thread (ms) | VS-Tree, all (ms) | speed-up |\n\
+             |---|--:|--:|--:|--:|--:|--:|--:|\n",
+        );
+        for one in &self.one_thread {
+            let Some(all) = self
+                .rows
+                .iter()
+                .find(|r| r.input == one.input && r.bound == one.bound)
+            else {
+                continue;
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {:.2} | {} | {} | {:.2} |",
+                one.input,
+                bound(one.bound),
+                ms(one.builds[0].seconds),
+                ms(all.builds[0].seconds),
+                one.builds[0].seconds / all.builds[0].seconds,
+                ms(one.builds[1].seconds),
+                ms(all.builds[1].seconds),
+                one.builds[1].seconds / all.builds[1].seconds,
+            );
+        }
+        md.push('\n');
+    }
+
+    fn clusters(&self, md: &mut String) {
+        md.push_str(
+            "### Clusters and simplified output\n\n\
+             Spread = variance / mean² of the samples per cluster (the paper: the variance \
+             roughly halves). S-leaves = share of the VS-Tree's clusters that are quadtree \
+             cells (S-nodes); the others are cubes (V- or T-node leaves), where the \
+             height-field test failed or passed only once the bound was met. Output = \
+             triangles of the simplified mesh (clouds have none). \
+             Distance = VS-Tree output to the input, mean / max relative to the input's \
+             bounding-box diagonal, from 200k points on the output's surface to the input's \
+             triangles.\n\n\
+             | input | L2 bound | octree spread | VS-Tree spread | ratio | T-layer depth \
+             | S-leaves | octree output | VS-Tree output | VS-Tree → input |\n\
+             |---|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+        );
+        for r in &self.rows {
+            let vs = &r.builds[1].stats;
+            let (oct_tris, vs_tris) = r.triangles.map_or(("—".into(), "—".into()), |[o, v]| {
+                (thousands(o), thousands(v))
+            });
+            let _ = writeln!(
+                md,
+                "| {} | {} | {:.2} | {:.2} | {:.2} | {}–{} | {} | {} | {} | {} |",
+                r.input,
+                bound(r.bound),
+                r.builds[0].spread(),
+                r.builds[1].spread(),
+                r.spread_ratio(),
+                vs.t_depth_min,
+                vs.t_depth_max,
+                percent(r.builds[1].surface_share()),
+                oct_tris,
+                vs_tris,
+                mean_max(r.distances.and_then(|d| d.out_in)),
+            );
+        }
+        md.push('\n');
+    }
+
+    fn simplification(&self, md: &mut String) {
+        if self.methods.is_empty() {
+            return;
+        }
+        md.push_str(
+            "### Simplification side by side with the peers\n\n\
+             Peers run at the VS-Tree's output size (PyMeshLab vertex clustering: cell size \
+             found by bisection; quadric edge collapse: `targetfacenum`, other parameters at \
+             their defaults). Times: vstree's whole `simplify` call (samples, tree, clustering) \
+             with all threads and with one; PyMeshLab's filter call (single-threaded). \
+             Distances relative to the diagonal, mean / max: output → input from 200k points \
+             on the output's surface; input → output from the input's vertices.\n\n\
+             | input | L2 bound | method | triangles | time (ms) | output → input \
+             | input → output | note |\n\
+             |---|--:|---|--:|--:|--:|--:|---|\n",
+        );
+        for m in &self.methods {
+            let time = match m.seconds_one_thread {
+                Some(one) => format!("{} (1 thread: {})", ms(m.seconds), ms(one)),
+                None => ms(m.seconds),
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                m.input,
+                bound(m.bound),
+                m.method,
+                thousands(m.triangles),
+                time,
+                mean_max(m.distances.out_in),
+                mean_max(m.distances.in_out),
+                m.note
+            );
+        }
+        md.push('\n');
+    }
+
+    fn memory_table(&self, md: &mut String) {
+        if self.memory.is_empty() {
+            return;
+        }
+        md.push_str(
+            "### Peak memory of a build\n\n\
+             Measured in a child process: resident size once the samples are in memory \
+             (baseline), and peak resident size during the build (`VmHWM`, reset after making \
+             the samples), per sample.\n\n\
+             | tree | samples | L2 bound | baseline (B/sample) | peak, total (B/sample) \
+             | peak over baseline (B/sample) |\n\
+             |---|--:|--:|--:|--:|--:|\n",
+        );
+        for m in &self.memory {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {:.1} | {:.1} | {:.1} |",
+                kind_name(m.kind),
+                short_count(m.samples),
+                bound(m.bound),
+                m.baseline_per_sample(),
+                m.total_per_sample(),
+                m.build_per_sample(),
+            );
+        }
+        if self.memory.iter().any(|m| !m.reset) {
+            md.push_str(
+                "\nThe peak counter could not be reset: peaks may include making the samples.\n",
+            );
+        }
+        md.push('\n');
+    }
+
+    /// The issue's targets, met or missed, with the numbers.
+    fn targets(&self, md: &mut String) {
+        let verdict = |met: bool| if met { "**met**" } else { "**missed**" };
+        md.push_str("### Targets (issue 2)\n\n");
+        if self.rows.is_empty() {
+            md.push_str("No inputs ran.\n\n");
+            return;
+        }
+        let gains: Vec<f64> = self.rows.iter().map(Row::gain).collect();
+        let met = gains.iter().filter(|&&g| g >= GAIN_TARGET).count();
+        let _ = writeln!(
+            md,
+            "- VS-Tree ≥ {} fewer clusters than the octree: {}: met on {met} of {} rows; gain \
+             min {}, median {}, max {}.",
+            percent(GAIN_TARGET),
+            verdict(met == gains.len()),
+            gains.len(),
+            percent(min(&gains)),
+            percent(crate::measure::median(&gains)),
+            percent(max(&gains)),
+        );
+        let ratios: Vec<f64> = self.rows.iter().map(Row::time_ratio).collect();
+        let faster = ratios.iter().filter(|&&r| r <= 1.0).count();
+        let close = ratios.iter().filter(|&&r| r <= 1.05).count();
+        let geo = (ratios.iter().map(|r| r.ln()).sum::<f64>() / ratios.len() as f64).exp();
+        let _ = writeln!(
+            md,
+            "- VS-Tree builds no slower than the octree: {}: met on {faster} of {} rows \
+             ({close} within 5%); time ratio VS/oct median {:.2}, geometric mean {geo:.2}, \
+             range {:.2}–{:.2}.",
+            verdict(faster == ratios.len()),
+            ratios.len(),
+            crate::measure::median(&ratios),
+            min(&ratios),
+            max(&ratios),
+        );
+        let biggest = self.rows.iter().map(|r| r.samples).max().unwrap_or(0);
+        if biggest >= 5_000_000 {
+            let big: Vec<&Row> = self.rows.iter().filter(|r| r.samples == biggest).collect();
+            let worst = big.iter().map(|r| r.builds[1].seconds).fold(0.0, f64::max);
+            let list: Vec<String> = big
+                .iter()
+                .map(|r| {
+                    format!(
+                        "{} s at {} (octree {} s)",
+                        seconds(r.builds[1].seconds),
+                        bound(r.bound),
+                        seconds(r.builds[0].seconds)
+                    )
+                })
+                .collect();
+            let _ = writeln!(
+                md,
+                "- {} samples build in under {BIG_SECONDS_TARGET} s: {}; VS-Tree {}.",
+                short_count(biggest),
+                verdict(worst < BIG_SECONDS_TARGET),
+                list.join(", ")
+            );
+        }
+        if !self.memory.is_empty() {
+            let total = self
+                .memory
+                .iter()
+                .map(Memory::total_per_sample)
+                .fold(0.0, f64::max);
+            let over = self
+                .memory
+                .iter()
+                .map(Memory::build_per_sample)
+                .fold(0.0, f64::max);
+            let _ = writeln!(
+                md,
+                "- Peak memory under {BYTES_TARGET} B/sample: {} counting everything \
+                 ({total:.1} B/sample at worst); the build itself adds at most {over:.1} \
+                 B/sample over the samples already in memory.",
+                verdict(total < BYTES_TARGET),
+            );
+        }
+        let spreads: Vec<f64> = self.rows.iter().map(Row::spread_ratio).collect();
+        let _ = writeln!(
+            md,
+            "- Cluster-size spread (paper: variance roughly halves): VS-Tree / octree spread \
+             median {:.2}, range {:.2}–{:.2}.\n",
+            crate::measure::median(&spreads),
+            min(&spreads),
+            max(&spreads),
+        );
+    }
+}
+
+fn min(v: &[f64]) -> f64 {
+    v.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+fn max(v: &[f64]) -> f64 {
+    v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// Replaces the block between [`BEGIN`] and [`END`] in `doc` with `block`, or appends the
+/// markers and block when they are missing (creating the file if needed).
+pub fn write_into(doc: &Path, block: &str) -> std::io::Result<()> {
+    let old = std::fs::read_to_string(doc).unwrap_or_else(|_| "# Benchmarks\n".into());
+    let generated = format!("{BEGIN}\n{block}{END}");
+    let new = match (old.find(BEGIN), old.find(END)) {
+        (Some(b), Some(e)) if b < e => {
+            format!("{}{generated}{}", &old[..b], &old[e + END.len()..])
+        }
+        _ => format!("{}\n{generated}\n", old.trim_end()),
+    };
+    if let Some(dir) = doc.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    std::fs::write(doc, new)
+}
