@@ -28,9 +28,7 @@ pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     let ab = b - a;
     let ac = c - a;
     let normal = ab.cross(ac);
-    if normal.length_squared()
-        <= f32::EPSILON * f32::EPSILON * ab.length_squared() * ac.length_squared()
-    {
+    if normal.length_squared() <= f32::EPSILON * f32::EPSILON * ab.length_squared() * ac.length_squared() {
         return closest_point_on_edges(p, a, b, c);
     }
     let ap = p - a;
@@ -86,14 +84,10 @@ fn closest_point_on_segment(p: Vec3, a: Vec3, b: Vec3) -> Vec3 {
 
 /// The closest point on the three edges of a (degenerate) triangle.
 fn closest_point_on_edges(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
-    [
-        closest_point_on_segment(p, a, b),
-        closest_point_on_segment(p, b, c),
-        closest_point_on_segment(p, c, a),
-    ]
-    .into_iter()
-    .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
-    .unwrap_or(a)
+    [closest_point_on_segment(p, a, b), closest_point_on_segment(p, b, c), closest_point_on_segment(p, c, a)]
+        .into_iter()
+        .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
+        .unwrap_or(a)
 }
 
 /// A node of a [`Bvh`]: its box, and either a range of items (leaf, `count > 0`) or the index
@@ -109,10 +103,7 @@ struct Node {
 impl Node {
     /// Squared distance from `p` to the node's box (0 inside).
     fn distance_squared(&self, p: Vec3) -> f32 {
-        (self.min - p)
-            .max(p - self.max)
-            .max(Vec3::ZERO)
-            .length_squared()
+        (self.min - p).max(p - self.max).max(Vec3::ZERO).length_squared()
     }
 }
 
@@ -181,27 +172,15 @@ impl BuildInput<'_> {
         let (min, max, axis) = self.bounds(items);
         let middle = self.split(items, axis);
         let (low, high) = items.split_at_mut(middle);
-        let (left, right) = rayon::join(
-            || self.subtree(low, offset),
-            || self.subtree(high, offset + middle),
-        );
+        let (left, right) = rayon::join(|| self.subtree(low, offset), || self.subtree(high, offset + middle));
         // Layout: [root, left root, right root, rest of left, rest of right]. Children indices
         // inside a subtree are never 0, so they shift by where that subtree's rest now starts.
         let shift = |node: &Node, by: usize| Node {
-            first: if node.count == 0 {
-                node.first + by as u32
-            } else {
-                node.first
-            },
+            first: if node.count == 0 { node.first + by as u32 } else { node.first },
             ..*node
         };
         let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
-        nodes.push(Node {
-            min,
-            max,
-            first: 1,
-            count: 0,
-        });
+        nodes.push(Node { min, max, first: 1, count: 0 });
         nodes.push(shift(&left[0], 2));
         nodes.push(shift(&right[0], left.len() + 1));
         nodes.extend(left[1..].iter().map(|n| shift(n, 2)));
@@ -211,12 +190,7 @@ impl BuildInput<'_> {
 
     /// [`BuildInput::subtree`] on one thread, with an explicit stack.
     fn sequential_subtree(&self, items: &mut [u32], offset: usize) -> Vec<Node> {
-        let blank = Node {
-            min: Vec3::ZERO,
-            max: Vec3::ZERO,
-            first: 0,
-            count: 0,
-        };
+        let blank = Node { min: Vec3::ZERO, max: Vec3::ZERO, first: 0, count: 0 };
         // A median split halves the count, so there are fewer than 4 n / leaf_size nodes.
         let mut nodes = Vec::with_capacity(4 * items.len() / self.leaf_size + 1);
         nodes.push(blank);
@@ -253,11 +227,7 @@ impl Bvh {
         }
         let centroids: Vec<Vec3> = boxes.par_iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
         let mut order: Vec<u32> = (0..n as u32).collect();
-        let input = BuildInput {
-            boxes,
-            centroids: &centroids,
-            leaf_size: leaf_size.max(1),
-        };
+        let input = BuildInput { boxes, centroids: &centroids, leaf_size: leaf_size.max(1) };
         let nodes = input.subtree(&mut order, 0);
         Bvh { nodes, order }
     }
@@ -265,11 +235,7 @@ impl Bvh {
     /// The item minimising `item_distance_squared(position, p)` over positions (indices into
     /// `order`), with its squared distance; `None` when empty or nothing compares below
     /// infinity. Ties keep the first found.
-    fn nearest(
-        &self,
-        p: Vec3,
-        item_distance_squared: impl Fn(usize) -> f32,
-    ) -> Option<(usize, f32)> {
+    fn nearest(&self, p: Vec3, item_distance_squared: impl Fn(usize) -> f32) -> Option<(usize, f32)> {
         let root = self.nodes.first()?;
         let mut best: Option<(usize, f32)> = None;
         let mut best_d2 = f32::INFINITY;
@@ -300,11 +266,7 @@ impl Bvh {
             let dl = self.nodes[left as usize].distance_squared(p);
             let dr = self.nodes[right as usize].distance_squared(p);
             // Push the farther child first so the nearer one is searched first.
-            let (near, d_near, far, d_far) = if dl <= dr {
-                (left, dl, right, dr)
-            } else {
-                (right, dr, left, dl)
-            };
+            let (near, d_near, far, d_far) = if dl <= dr { (left, dl, right, dr) } else { (right, dr, left, dl) };
             if d_far < best_d2 && depth < MAX_STACK {
                 stack[depth] = far;
                 depth += 1;
@@ -358,18 +320,12 @@ impl TriangleBvh {
             .filter(|(_, tri)| tri.iter().all(|&v| (v as usize) < p.len()))
             .map(|(i, tri)| (tri.map(|v| p[v as usize]), i as u32))
             .unzip();
-        let boxes: Vec<(Vec3, Vec3)> = corners
-            .par_iter()
-            .map(|[a, b, c]| (a.min(*b).min(*c), a.max(*b).max(*c)))
-            .collect();
+        let boxes: Vec<(Vec3, Vec3)> =
+            corners.par_iter().map(|[a, b, c]| (a.min(*b).min(*c), a.max(*b).max(*c))).collect();
         let bvh = Bvh::build(&boxes, TRIANGLE_LEAF);
         let corners_sorted = bvh.order.iter().map(|&i| corners[i as usize]).collect();
         let ids_sorted = bvh.order.iter().map(|&i| ids[i as usize]).collect();
-        TriangleBvh {
-            bvh,
-            corners: corners_sorted,
-            ids: ids_sorted,
-        }
+        TriangleBvh { bvh, corners: corners_sorted, ids: ids_sorted }
     }
 
     /// Number of triangles in the hierarchy.
@@ -389,14 +345,8 @@ impl TriangleBvh {
             let [a, b, c] = self.corners[position];
             closest_point_on_triangle(p, a, b, c)
         };
-        let (position, d2) = self
-            .bvh
-            .nearest(p, |position| point_of(position).distance_squared(p))?;
-        Some(Closest {
-            distance: d2.sqrt(),
-            triangle: self.ids[position],
-            point: point_of(position),
-        })
+        let (position, d2) = self.bvh.nearest(p, |position| point_of(position).distance_squared(p))?;
+        Some(Closest { distance: d2.sqrt(), triangle: self.ids[position], point: point_of(position) })
     }
 
     /// Distance from `p` to the triangles: `f32::INFINITY` when there are none, NaN when `p` has
@@ -424,10 +374,7 @@ impl PointBvh {
         let boxes: Vec<(Vec3, Vec3)> = points.par_iter().map(|&p| (p, p)).collect();
         let bvh = Bvh::build(&boxes, POINT_LEAF);
         let sorted = bvh.order.iter().map(|&i| points[i as usize]).collect();
-        PointBvh {
-            bvh,
-            points: sorted,
-        }
+        PointBvh { bvh, points: sorted }
     }
 
     /// Number of points in the hierarchy.
@@ -443,9 +390,7 @@ impl PointBvh {
     /// The nearest point to `p` as (distance, index in the input slice), or `None` when the
     /// cloud is empty or `p` has a NaN coordinate.
     pub fn nearest(&self, p: Vec3) -> Option<(f32, u32)> {
-        let (position, d2) = self
-            .bvh
-            .nearest(p, |position| self.points[position].distance_squared(p))?;
+        let (position, d2) = self.bvh.nearest(p, |position| self.points[position].distance_squared(p))?;
         Some((d2.sqrt(), self.bvh.order[position]))
     }
 
@@ -568,18 +513,10 @@ fn representative_points(mesh: &Mesh, samples: usize, seed: u64) -> Vec<Vec3> {
 /// all its points. Those points are measured to the other side's triangles, or to its points
 /// when it is a cloud. A side with no representative points (empty, or zero area) gives
 /// `count == 0` statistics in its direction, and measuring to it gives infinite distances.
-pub fn two_sided(
-    a: &Mesh,
-    b: &Mesh,
-    samples_per_mesh: usize,
-    seed: u64,
-) -> (DistanceStats, DistanceStats) {
+pub fn two_sided(a: &Mesh, b: &Mesh, samples_per_mesh: usize, seed: u64) -> (DistanceStats, DistanceStats) {
     let from_a = representative_points(a, samples_per_mesh, stream_seed(seed, 0));
     let from_b = representative_points(b, samples_per_mesh, stream_seed(seed, 1));
-    (
-        one_sided(&from_a, Target::of(b)),
-        one_sided(&from_b, Target::of(a)),
-    )
+    (one_sided(&from_a, Target::of(b)), one_sided(&from_b, Target::of(a)))
 }
 
 /// The symmetric Chamfer and Hausdorff distances between `a` and `b`, from [`two_sided`]:
@@ -603,11 +540,8 @@ mod tests {
         let (p, a, b, c) = (p.as_dvec3(), a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
         let segment = |a: DVec3, b: DVec3| {
             let ab = b - a;
-            let t = if ab.length_squared() > 0.0 {
-                ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
+            let t =
+                if ab.length_squared() > 0.0 { ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0) } else { 0.0 };
             (a + ab * t).distance(p)
         };
         let edges = segment(a, b).min(segment(b, c)).min(segment(c, a));
@@ -616,9 +550,7 @@ mod tests {
             return edges;
         }
         let q = p - n * ((p - a).dot(n) / n.length_squared());
-        let inside = [(a, b), (b, c), (c, a)]
-            .iter()
-            .all(|&(u, v)| (v - u).cross(q - u).dot(n) >= 0.0);
+        let inside = [(a, b), (b, c), (c, a)].iter().all(|&(u, v)| (v - u).cross(q - u).dot(n) >= 0.0);
         if inside {
             q.distance(p)
         } else {
@@ -634,18 +566,11 @@ mod tests {
     fn point_triangle_matches_oracle() {
         let mut rng = Rng::new(11);
         for _ in 0..20_000 {
-            let (a, b, c) = (
-                random_vec(&mut rng),
-                random_vec(&mut rng),
-                random_vec(&mut rng),
-            );
+            let (a, b, c) = (random_vec(&mut rng), random_vec(&mut rng), random_vec(&mut rng));
             let p = random_vec(&mut rng) * 2.0;
             let got = f64::from(closest_point_on_triangle(p, a, b, c).distance(p));
             let want = oracle_distance(p, a, b, c);
-            assert!(
-                (got - want).abs() < 1e-5,
-                "{p} {a} {b} {c}: {got} vs {want}"
-            );
+            assert!((got - want).abs() < 1e-5, "{p} {a} {b} {c}: {got} vs {want}");
         }
         // Degenerate triangles: a point, a segment, collinear corners.
         let p = Vec3::new(0.3, 1.0, 0.0);
@@ -683,19 +608,12 @@ mod tests {
                 .iter()
                 .map(|t| {
                     let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-                    closest_point_on_triangle(p, a, b, c)
-                        .distance_squared(p)
-                        .sqrt()
+                    closest_point_on_triangle(p, a, b, c).distance_squared(p).sqrt()
                 })
                 .fold(f32::INFINITY, f32::min);
             let found = bvh.closest_point(p).unwrap();
-            assert!(
-                (found.distance - brute).abs() <= 1e-6,
-                "{} vs {brute}",
-                found.distance
-            );
-            let [a, b, c] =
-                mesh.triangles[found.triangle as usize].map(|v| mesh.positions[v as usize]);
+            assert!((found.distance - brute).abs() <= 1e-6, "{} vs {brute}", found.distance);
+            let [a, b, c] = mesh.triangles[found.triangle as usize].map(|v| mesh.positions[v as usize]);
             assert!((closest_point_on_triangle(p, a, b, c) - found.point).length() <= 1e-6);
         }
     }
@@ -738,11 +656,7 @@ mod tests {
             })
             .collect();
         let build = |threads| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-                .install(|| Bvh::build(&boxes, 4))
+            rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| Bvh::build(&boxes, 4))
         };
         let (one, two) = (build(1), build(2));
         validate(&two, &boxes, 4);
@@ -763,33 +677,21 @@ mod tests {
         let bvh = PointBvh::new(&cloud);
         let fast = point_to_points_distances(&queries, &cloud);
         for (q, d) in queries.iter().zip(&fast) {
-            let (brute_index, brute) = cloud
-                .iter()
-                .enumerate()
-                .map(|(i, c)| (i, c.distance(*q)))
-                .min_by(|x, y| x.1.total_cmp(&y.1))
-                .unwrap();
+            let (brute_index, brute) =
+                cloud.iter().enumerate().map(|(i, c)| (i, c.distance(*q))).min_by(|x, y| x.1.total_cmp(&y.1)).unwrap();
             assert!((d - brute).abs() <= 1e-6);
             let (d2, index) = bvh.nearest(*q).unwrap();
             assert_eq!(d2, *d);
-            assert!(
-                (cloud[index as usize].distance(*q) - brute).abs() <= 1e-6,
-                "{brute_index}"
-            );
+            assert!((cloud[index as usize].distance(*q) - brute).abs() <= 1e-6, "{brute_index}");
         }
     }
 
     #[test]
     fn empty_targets_and_stats() {
         let p = [Vec3::ONE];
-        assert_eq!(
-            point_to_mesh_distances(&p, &Mesh::default()),
-            vec![f32::INFINITY]
-        );
+        assert_eq!(point_to_mesh_distances(&p, &Mesh::default()), vec![f32::INFINITY]);
         assert_eq!(point_to_points_distances(&p, &[]), vec![f32::INFINITY]);
-        assert!(TriangleBvh::new(&Mesh::default())
-            .closest_point(Vec3::ZERO)
-            .is_none());
+        assert!(TriangleBvh::new(&Mesh::default()).closest_point(Vec3::ZERO).is_none());
         let mut bad = Mesh::from_points(vec![Vec3::ZERO], None);
         bad.triangles.push([0, 1, 2]);
         assert!(TriangleBvh::new(&bad).is_empty());
@@ -804,10 +706,7 @@ mod tests {
         assert_eq!((s.mean, s.rms, s.max, s.p99), (3.0, 3.0, 3.0, 3.0));
 
         let cloud = Mesh::from_points(vec![Vec3::ZERO, Vec3::X * 10.0], None);
-        assert_eq!(
-            chamfer_and_hausdorff(&Mesh::default(), &Mesh::default(), 10, 1),
-            (0.0, 0.0)
-        );
+        assert_eq!(chamfer_and_hausdorff(&Mesh::default(), &Mesh::default(), 10, 1), (0.0, 0.0));
         let (c, h) = chamfer_and_hausdorff(&cloud, &Mesh::default(), 10, 1);
         assert!(c.is_infinite() && h.is_infinite());
         let shifted = Mesh::from_points(vec![Vec3::Y, Vec3::X * 10.0 + Vec3::Y * 3.0], None);

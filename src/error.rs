@@ -8,17 +8,10 @@ use std::path::{Path, PathBuf};
 #[derive(Debug)]
 pub enum Error {
     /// The operating system refused a read or write.
-    Io {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Io { path: PathBuf, source: std::io::Error },
     /// A file's content is not what its format requires.
     /// `location` is e.g. `"line 12"` or `"vertex element 17"`.
-    Parse {
-        path: PathBuf,
-        location: String,
-        message: String,
-    },
+    Parse { path: PathBuf, location: String, message: String },
     /// The file extension names no format vstree reads or writes.
     UnsupportedFormat { path: PathBuf },
     /// A parameter is out of its documented range; `name` is the parameter's name.
@@ -36,29 +29,15 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
     pub(crate) fn io(path: &Path, source: std::io::Error) -> Self {
-        Error::Io {
-            path: path.to_path_buf(),
-            source,
-        }
+        Error::Io { path: path.to_path_buf(), source }
     }
 
-    pub(crate) fn parse(
-        path: &Path,
-        location: impl Into<String>,
-        message: impl Into<String>,
-    ) -> Self {
-        Error::Parse {
-            path: path.to_path_buf(),
-            location: location.into(),
-            message: message.into(),
-        }
+    pub(crate) fn parse(path: &Path, location: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Parse { path: path.to_path_buf(), location: location.into(), message: message.into() }
     }
 
     pub(crate) fn param(name: &'static str, message: impl Into<String>) -> Self {
-        Error::InvalidParameter {
-            name,
-            message: message.into(),
-        }
+        Error::InvalidParameter { name, message: message.into() }
     }
 
     pub(crate) fn input(message: impl Into<String>) -> Self {
@@ -70,18 +49,12 @@ impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Io { path, source } => write!(f, "{}: {source}", path.display()),
-            Error::Parse {
-                path,
-                location,
-                message,
-            } => {
+            Error::Parse { path, location, message } => {
                 write!(f, "{}: {location}: {message}", path.display())
             }
-            Error::UnsupportedFormat { path } => write!(
-                f,
-                "{}: unsupported file format (expected .ply, .obj, .off, .xyz or .pwn)",
-                path.display()
-            ),
+            Error::UnsupportedFormat { path } => {
+                write!(f, "{}: unsupported file format (expected .ply, .obj, .off, .xyz or .pwn)", path.display())
+            }
             Error::InvalidParameter { name, message } => write!(f, "parameter `{name}`: {message}"),
             Error::InvalidInput(message) => write!(f, "invalid input: {message}"),
             Error::TooLarge(message) => write!(f, "too large: {message}"),

@@ -92,13 +92,8 @@ fn split_node(entries: &mut [Entry]) -> Split {
         }
     }
     let mid = entries.len() / 2;
-    entries.select_nth_unstable_by(mid, |a, b| {
-        a.p[axis].total_cmp(&b.p[axis]).then(a.id.cmp(&b.id))
-    });
-    Split {
-        value: entries[mid].p[axis],
-        axis: axis as u32,
-    }
+    entries.select_nth_unstable_by(mid, |a, b| a.p[axis].total_cmp(&b.p[axis]).then(a.id.cmp(&b.id)));
+    Split { value: entries[mid].p[axis], axis: axis as u32 }
 }
 
 /// The k best candidates so far, sorted by (distance, index).
@@ -113,11 +108,7 @@ struct Best {
 
 impl Best {
     fn new(k: usize) -> Best {
-        Best {
-            k,
-            items: Vec::with_capacity(k + 1),
-            bound: f32::INFINITY,
-        }
+        Best { k, items: Vec::with_capacity(k + 1), bound: f32::INFINITY }
     }
 
     fn clear(&mut self) {
@@ -161,25 +152,13 @@ impl KdTree {
     /// points.
     pub fn new(points: &[Vec3]) -> Result<KdTree> {
         if points.len() >= u32::MAX as usize {
-            return Err(Error::TooLarge(format!(
-                "{} points (at most {})",
-                points.len(),
-                u32::MAX - 1
-            )));
+            return Err(Error::TooLarge(format!("{} points (at most {})", points.len(), u32::MAX - 1)));
         }
         if let Some(i) = points.par_iter().position_first(|p| !p.is_finite()) {
-            return Err(Error::input(format!(
-                "point {i} has a NaN or infinite coordinate"
-            )));
+            return Err(Error::input(format!("point {i} has a NaN or infinite coordinate")));
         }
-        let mut entries: Vec<Entry> = points
-            .par_iter()
-            .enumerate()
-            .map(|(i, p)| Entry {
-                p: p.to_array(),
-                id: i as u32,
-            })
-            .collect();
+        let mut entries: Vec<Entry> =
+            points.par_iter().enumerate().map(|(i, p)| Entry { p: p.to_array(), id: i as u32 }).collect();
         let levels = inner_levels(entries.len());
         let mut splits = Vec::with_capacity((1usize << levels) - 1);
         // The nodes of one level own disjoint ranges: split them all in parallel, then cut
@@ -219,13 +198,7 @@ impl KdTree {
         }
         let mut best = Best::new(k);
         self.search(p.to_array(), u32::MAX, &mut best);
-        best.items
-            .iter()
-            .map(|&(d2, id, _)| Neighbour {
-                index: id,
-                distance_squared: d2,
-            })
-            .collect()
+        best.items.iter().map(|&(d2, id, _)| Neighbour { index: id, distance_squared: d2 }).collect()
     }
 
     /// For every input point, the input indices of its `k` nearest *other* points (the point
@@ -245,14 +218,12 @@ impl KdTree {
             position_of[e.id as usize] = position as u32;
         }
         let mut out = vec![0u32; n * k];
-        out.par_chunks_mut(k)
-            .zip(position_of.par_iter())
-            .for_each(|(row, &position)| {
-                let from = &by_position[position as usize * k..][..k];
-                for (o, &q) in row.iter_mut().zip(from) {
-                    *o = self.entries[q as usize].id;
-                }
-            });
+        out.par_chunks_mut(k).zip(position_of.par_iter()).for_each(|(row, &position)| {
+            let from = &by_position[position as usize * k..][..k];
+            for (o, &q) in row.iter_mut().zip(from) {
+                *o = self.entries[q as usize].id;
+            }
+        });
         Ok(out)
     }
 
@@ -262,10 +233,7 @@ impl KdTree {
             return Err(Error::param("k", format!("{k} is not in 1..={MAX_K}")));
         }
         if k >= self.len() {
-            return Err(Error::input(format!(
-                "{} points: each needs {k} other points as neighbours",
-                self.len()
-            )));
+            return Err(Error::input(format!("{} points: each needs {k} other points as neighbours", self.len())));
         }
         Ok(())
     }
@@ -276,19 +244,17 @@ impl KdTree {
     /// Working in tree order keeps neighbouring points close in memory. `k` must pass
     /// [`KdTree::check_k`].
     pub(crate) fn knn_positions(&self, k: usize, first: usize, out: &mut [u32]) {
-        out.par_chunks_mut(k * BATCH)
-            .enumerate()
-            .for_each(|(chunk, rows)| {
-                let mut best = Best::new(k);
-                for (r, row) in rows.chunks_exact_mut(k).enumerate() {
-                    let position = first + chunk * BATCH + r;
-                    best.clear();
-                    self.search(self.entries[position].p, position as u32, &mut best);
-                    for (o, item) in row.iter_mut().zip(&best.items) {
-                        *o = item.2;
-                    }
+        out.par_chunks_mut(k * BATCH).enumerate().for_each(|(chunk, rows)| {
+            let mut best = Best::new(k);
+            for (r, row) in rows.chunks_exact_mut(k).enumerate() {
+                let position = first + chunk * BATCH + r;
+                best.clear();
+                self.search(self.entries[position].p, position as u32, &mut best);
+                for (o, item) in row.iter_mut().zip(&best.items) {
+                    *o = item.2;
                 }
-            });
+            }
+        });
     }
 
     /// The point at tree position `position`.
@@ -309,16 +275,7 @@ impl KdTree {
     /// Searches node `node` (points `begin..end`); `offset` holds, per axis, a lower bound of
     /// the distance from `q` to the node's cell.
     #[allow(clippy::too_many_arguments)]
-    fn visit(
-        &self,
-        node: usize,
-        begin: usize,
-        end: usize,
-        q: [f32; 3],
-        offset: [f32; 3],
-        skip: u32,
-        best: &mut Best,
-    ) {
+    fn visit(&self, node: usize, begin: usize, end: usize, q: [f32; 3], offset: [f32; 3], skip: u32, best: &mut Best) {
         if node >= self.splits.len() {
             for (position, e) in self.entries[begin..end].iter().enumerate() {
                 let position = (begin + position) as u32;
@@ -380,9 +337,7 @@ mod tests {
 
     fn random_points(n: usize, seed: u64) -> Vec<Vec3> {
         let mut rng = Rng::new(seed);
-        (0..n)
-            .map(|_| Vec3::new(rng.f32(), rng.f32(), rng.f32() * 0.1))
-            .collect()
+        (0..n).map(|_| Vec3::new(rng.f32(), rng.f32(), rng.f32() * 0.1)).collect()
     }
 
     /// Integer grid points with duplicates: many exact distance ties.
@@ -390,11 +345,7 @@ mod tests {
         let mut points = Vec::new();
         for i in 0..600u32 {
             let v = (i * 7919) % 343;
-            points.push(Vec3::new(
-                (v % 7) as f32,
-                ((v / 7) % 7) as f32,
-                (v / 49) as f32,
-            ));
+            points.push(Vec3::new((v % 7) as f32, ((v / 7) % 7) as f32, (v / 49) as f32));
         }
         points
     }
@@ -407,11 +358,7 @@ mod tests {
             for _ in 0..200 {
                 let q = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 8.0 - 1.0;
                 for k in [1, 5, 17] {
-                    let got: Vec<(f32, u32)> = tree
-                        .knn(q, k)
-                        .iter()
-                        .map(|n| (n.distance_squared, n.index))
-                        .collect();
+                    let got: Vec<(f32, u32)> = tree.knn(q, k).iter().map(|n| (n.distance_squared, n.index)).collect();
                     assert_eq!(got, oracle(&points, q, k, None), "q {q} k {k}");
                 }
             }
@@ -425,10 +372,7 @@ mod tests {
             let all = knn_all(&points, k).unwrap();
             assert_eq!(all.len(), points.len() * k);
             for (i, row) in all.chunks(k).enumerate() {
-                let want: Vec<u32> = oracle(&points, points[i], k, Some(i))
-                    .iter()
-                    .map(|x| x.1)
-                    .collect();
+                let want: Vec<u32> = oracle(&points, points[i], k, Some(i)).iter().map(|x| x.1).collect();
                 assert_eq!(row, &want[..], "point {i}");
             }
         }
@@ -437,11 +381,7 @@ mod tests {
     #[test]
     fn same_answer_for_any_thread_count() {
         let points = random_points(50_000, 3);
-        let run = |threads: usize| {
-            crate::Threads::new(threads)
-                .unwrap()
-                .run(|| knn_all(&points, 8).unwrap())
-        };
+        let run = |threads: usize| crate::Threads::new(threads).unwrap().run(|| knn_all(&points, 8).unwrap());
         assert_eq!(run(1), run(2));
         assert_eq!(run(1), run(3));
     }

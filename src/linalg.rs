@@ -10,14 +10,7 @@ pub struct Sym3(pub [f64; 6]);
 impl Sym3 {
     /// `v vᵀ`.
     pub fn outer(v: DVec3) -> Sym3 {
-        Sym3([
-            v.x * v.x,
-            v.x * v.y,
-            v.x * v.z,
-            v.y * v.y,
-            v.y * v.z,
-            v.z * v.z,
-        ])
+        Sym3([v.x * v.x, v.x * v.y, v.x * v.z, v.y * v.y, v.y * v.z, v.z * v.z])
     }
 
     pub fn add(&mut self, other: &Sym3) {
@@ -40,11 +33,7 @@ impl Sym3 {
 
     pub fn mul_vec(&self, v: DVec3) -> DVec3 {
         let [xx, xy, xz, yy, yz, zz] = self.0;
-        DVec3::new(
-            xx * v.x + xy * v.y + xz * v.z,
-            xy * v.x + yy * v.y + yz * v.z,
-            xz * v.x + yz * v.y + zz * v.z,
-        )
+        DVec3::new(xx * v.x + xy * v.y + xz * v.z, xy * v.x + yy * v.y + yz * v.z, xz * v.x + yz * v.y + zz * v.z)
     }
 
     /// Eigenvalues (descending) and the matching unit eigenvectors (as matrix columns),
@@ -95,11 +84,7 @@ impl Sym3 {
 
     pub fn to_mat3(self) -> DMat3 {
         let [xx, xy, xz, yy, yz, zz] = self.0;
-        DMat3::from_cols(
-            DVec3::new(xx, xy, xz),
-            DVec3::new(xy, yy, yz),
-            DVec3::new(xz, yz, zz),
-        )
+        DMat3::from_cols(DVec3::new(xx, xy, xz), DVec3::new(xy, yy, yz), DVec3::new(xz, yz, zz))
     }
 }
 

@@ -26,9 +26,7 @@ impl Aabb {
     /// The box of `points`, or `None` when there are none.
     pub fn of(points: &[Vec3]) -> Option<Aabb> {
         let first = *points.first()?;
-        let (min, max) = points
-            .iter()
-            .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let (min, max) = points.iter().fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
         Some(Aabb { min, max })
     }
 
@@ -45,11 +43,7 @@ impl Aabb {
 impl Mesh {
     /// A point cloud (no triangles), with or without normals.
     pub fn from_points(positions: Vec<Vec3>, normals: Option<Vec<Vec3>>) -> Mesh {
-        Mesh {
-            positions,
-            normals,
-            triangles: Vec::new(),
-        }
+        Mesh { positions, normals, triangles: Vec::new() }
     }
 
     pub fn is_point_cloud(&self) -> bool {
@@ -64,30 +58,20 @@ impl Mesh {
     /// positions and finite, triangle indices in range. The error names the first offender.
     pub fn check(&self) -> Result<()> {
         if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
-            return Err(Error::input(format!(
-                "vertex {i} has a NaN or infinite coordinate"
-            )));
+            return Err(Error::input(format!("vertex {i} has a NaN or infinite coordinate")));
         }
         if let Some(normals) = &self.normals {
             if normals.len() != self.positions.len() {
-                return Err(Error::input(format!(
-                    "{} normals for {} vertices",
-                    normals.len(),
-                    self.positions.len()
-                )));
+                return Err(Error::input(format!("{} normals for {} vertices", normals.len(), self.positions.len())));
             }
             if let Some(i) = normals.iter().position(|n| !n.is_finite()) {
-                return Err(Error::input(format!(
-                    "normal {i} has a NaN or infinite component"
-                )));
+                return Err(Error::input(format!("normal {i} has a NaN or infinite component")));
             }
         }
         let n = self.positions.len() as u64;
         for (t, tri) in self.triangles.iter().enumerate() {
             if let Some(&bad) = tri.iter().find(|&&i| u64::from(i) >= n) {
-                return Err(Error::input(format!(
-                    "triangle {t} uses vertex {bad}, but there are only {n} vertices"
-                )));
+                return Err(Error::input(format!("triangle {t} uses vertex {bad}, but there are only {n} vertices")));
             }
         }
         Ok(())

@@ -119,10 +119,7 @@ impl NormalParams {
         if !(MIN_NEIGHBOURS..=MAX_NEIGHBOURS).contains(&self.neighbours) {
             return Err(Error::param(
                 "neighbours",
-                format!(
-                    "{} is not in {MIN_NEIGHBOURS}..={MAX_NEIGHBOURS}",
-                    self.neighbours
-                ),
+                format!("{} is not in {MIN_NEIGHBOURS}..={MAX_NEIGHBOURS}", self.neighbours),
             ));
         }
         Ok(())
@@ -163,11 +160,7 @@ pub struct NormalsReport {
 /// Errors: fewer than 3 points, a NaN or infinite coordinate (naming the point), all points
 /// equal or on one line (no plane to fit), a bad parameter, or [`Error::Cancelled`]. Points on
 /// one plane get that plane's normal, consistently signed. Duplicate points are fine.
-pub fn estimate_normals(
-    points: &[Vec3],
-    params: &NormalParams,
-    progress: &mut Progress,
-) -> Result<Vec<Vec3>> {
+pub fn estimate_normals(points: &[Vec3], params: &NormalParams, progress: &mut Progress) -> Result<Vec<Vec3>> {
     let threads = prepare(points, params)?;
     let fallback = plane_through(points, &threads)?;
     let graph = Graph::build(points, params.neighbours, &threads, progress)?;
@@ -211,17 +204,11 @@ pub fn orient_normals(
 ///
 /// Normals this function writes are unit length; given normals it keeps are left untouched.
 /// Triangles, if any, are ignored: the positions are treated as a cloud.
-pub fn ensure_normals(
-    cloud: &mut Mesh,
-    params: &NormalParams,
-    progress: &mut Progress,
-) -> Result<NormalsReport> {
+pub fn ensure_normals(cloud: &mut Mesh, params: &NormalParams, progress: &mut Progress) -> Result<NormalsReport> {
     cloud.check()?;
     let missing: Vec<u32> = match &cloud.normals {
         None => (0..cloud.positions.len() as u32).collect(),
-        Some(given) => (0..given.len() as u32)
-            .filter(|&i| given[i as usize] == Vec3::ZERO)
-            .collect(),
+        Some(given) => (0..given.len() as u32).filter(|&i| given[i as usize] == Vec3::ZERO).collect(),
     };
     let n = cloud.positions.len();
     if missing.len() == n {
@@ -232,23 +219,14 @@ pub fn ensure_normals(
         let orient = graph.orient(&mut normals, params.orient, &threads, progress)?;
         progress.report(1.0, "normals: done")?;
         cloud.normals = Some(graph.to_input_order(&normals));
-        return Ok(NormalsReport {
-            estimated: n,
-            neighbours: graph.k,
-            degenerate,
-            orient,
-        });
+        return Ok(NormalsReport { estimated: n, neighbours: graph.k, degenerate, orient });
     }
     if missing.is_empty() && !params.reorient_given {
         return Ok(NormalsReport::default());
     }
     let given = cloud.normals.as_mut().expect("normals checked above");
     let threads = prepare(&cloud.positions, params)?;
-    let fallback = if missing.is_empty() {
-        Vec3::ZERO
-    } else {
-        plane_through(&cloud.positions, &threads)?
-    };
+    let fallback = if missing.is_empty() { Vec3::ZERO } else { plane_through(&cloud.positions, &threads)? };
     let graph = Graph::build(&cloud.positions, params.neighbours, &threads, progress)?;
     let mut degenerate = 0;
     let mut ordered = graph.to_tree_order(given);
@@ -257,55 +235,32 @@ pub fn ensure_normals(
         degenerate = bad;
         graph.fill_from_given(&mut ordered, &estimated, &threads);
     }
-    let orient = if params.reorient_given {
-        graph.orient(&mut ordered, params.orient, &threads, progress)?
-    } else {
-        None
-    };
+    let orient =
+        if params.reorient_given { graph.orient(&mut ordered, params.orient, &threads, progress)? } else { None };
     progress.report(1.0, "normals: done")?;
-    let unit: Vec<Vec3> = graph
-        .to_input_order(&ordered)
-        .iter()
-        .map(|n| n.normalize_or_zero())
-        .collect();
+    let unit: Vec<Vec3> = graph.to_input_order(&ordered).iter().map(|n| n.normalize_or_zero()).collect();
     *given = unit;
-    Ok(NormalsReport {
-        estimated: missing.len(),
-        neighbours: graph.k,
-        degenerate,
-        orient,
-    })
+    Ok(NormalsReport { estimated: missing.len(), neighbours: graph.k, degenerate, orient })
 }
 
 /// Checks the parameters and the points every entry point needs, and makes the thread pool.
 fn prepare(points: &[Vec3], params: &NormalParams) -> Result<Threads> {
     params.check()?;
     if points.len() < 3 {
-        return Err(Error::input(format!(
-            "{} points: normals need at least 3",
-            points.len()
-        )));
+        return Err(Error::input(format!("{} points: normals need at least 3", points.len())));
     }
     if let Some(i) = points.iter().position(|p| !p.is_finite()) {
-        return Err(Error::input(format!(
-            "point {i} has a NaN or infinite coordinate"
-        )));
+        return Err(Error::input(format!("point {i} has a NaN or infinite coordinate")));
     }
     Threads::new(params.threads)
 }
 
 fn check_normals(points: &[Vec3], normals: &[Vec3]) -> Result<()> {
     if normals.len() != points.len() {
-        return Err(Error::input(format!(
-            "{} normals for {} points",
-            normals.len(),
-            points.len()
-        )));
+        return Err(Error::input(format!("{} normals for {} points", normals.len(), points.len())));
     }
     if let Some(i) = normals.iter().position(|n| !n.is_finite()) {
-        return Err(Error::input(format!(
-            "normal {i} has a NaN or infinite component"
-        )));
+        return Err(Error::input(format!("normal {i} has a NaN or infinite component")));
     }
     Ok(())
 }
@@ -313,9 +268,7 @@ fn check_normals(points: &[Vec3], normals: &[Vec3]) -> Result<()> {
 /// About two ulps of the cloud's largest coordinate: coordinate differences this small are f32
 /// rounding noise, and spreads this small span nothing.
 fn rounding_noise(points: &[Vec3]) -> f64 {
-    let largest = points
-        .iter()
-        .fold(0.0f32, |m, p| m.max(p.abs().max_element()));
+    let largest = points.iter().fold(0.0f32, |m, p| m.max(p.abs().max_element()));
     2.0 * f64::from(f32::EPSILON) * f64::from(largest)
 }
 
@@ -329,38 +282,29 @@ fn plane_through(points: &[Vec3], threads: &Threads) -> Result<Vec3> {
         points
             .par_chunks(CHUNK)
             .map(|chunk| {
-                chunk
-                    .iter()
-                    .fold((DVec3::ZERO, Sym3::default()), |(s, mut c), p| {
-                        let d = p.as_dvec3() - origin;
-                        c.add(&Sym3::outer(d));
-                        (s + d, c)
-                    })
+                chunk.iter().fold((DVec3::ZERO, Sym3::default()), |(s, mut c), p| {
+                    let d = p.as_dvec3() - origin;
+                    c.add(&Sym3::outer(d));
+                    (s + d, c)
+                })
             })
             .collect()
     });
     // Chunks are summed in order: the same result for any thread count.
-    let (sum, second) =
-        partial
-            .iter()
-            .fold((DVec3::ZERO, Sym3::default()), |(s, mut c), (ps, pc)| {
-                c.add(pc);
-                (s + *ps, c)
-            });
+    let (sum, second) = partial.iter().fold((DVec3::ZERO, Sym3::default()), |(s, mut c), (ps, pc)| {
+        c.add(pc);
+        (s + *ps, c)
+    });
     let mean = sum / n as f64;
     let scatter = second.sub(&Sym3::outer(mean).scaled(n as f64));
     let (values, vectors) = scatter.eigen();
     let noise = rounding_noise(points);
     let floor = noise * noise * n as f64;
     if values[0] <= floor {
-        return Err(Error::input(format!(
-            "all {n} points are at the same place: no plane to estimate normals from"
-        )));
+        return Err(Error::input(format!("all {n} points are at the same place: no plane to estimate normals from")));
     }
     if values[1] <= floor.max(1e-12 * values[0]) {
-        return Err(Error::input(format!(
-            "all {n} points lie on one line: no plane to estimate normals from"
-        )));
+        return Err(Error::input(format!("all {n} points lie on one line: no plane to estimate normals from")));
     }
     Ok(vectors[2].as_vec3())
 }
@@ -381,43 +325,27 @@ struct Graph {
 
 impl Graph {
     /// The k-d tree and every point's `min(k, n - 1)` nearest neighbours.
-    fn build(
-        points: &[Vec3],
-        k: usize,
-        threads: &Threads,
-        progress: &mut Progress,
-    ) -> Result<Graph> {
+    fn build(points: &[Vec3], k: usize, threads: &Threads, progress: &mut Progress) -> Result<Graph> {
         let n = points.len();
         let k = k.min(n - 1);
         // Edge numbers t * k + slot fit in 31 bits (the 32nd carries a sign, see
         // `sorted_edges`), and so, with k >= 2, do point indices.
         if (n as u64) * (k as u64) >= 1 << 31 {
-            return Err(Error::TooLarge(format!(
-                "{n} points x {k} neighbours (at most 2^31 neighbour links)"
-            )));
+            return Err(Error::TooLarge(format!("{n} points x {k} neighbours (at most 2^31 neighbour links)")));
         }
         progress.report(0.0, "normals: k-d tree")?;
         let tree = threads.run(|| KdTree::new(points))?;
         tree.check_k(k)?;
         let mut rows = vec![0u32; n * k];
         for (slice, out) in rows.chunks_mut(QUERY_SLICE * k).enumerate() {
-            progress.report(
-                0.05 + 0.45 * (slice * QUERY_SLICE) as f32 / n as f32,
-                "normals: neighbours",
-            )?;
+            progress.report(0.05 + 0.45 * (slice * QUERY_SLICE) as f32 / n as f32, "normals: neighbours")?;
             threads.run(|| tree.knn_positions(k, slice * QUERY_SLICE, out));
         }
         let mut position_of = vec![0u32; n];
         for t in 0..n {
             position_of[tree.index(t) as usize] = t as u32;
         }
-        Ok(Graph {
-            tree,
-            k,
-            rows,
-            position_of,
-            noise: rounding_noise(points),
-        })
+        Ok(Graph { tree, k, rows, position_of, noise: rounding_noise(points) })
     }
 
     fn len(&self) -> usize {
@@ -430,35 +358,20 @@ impl Graph {
 
     /// Per-point values given in input order, in tree order.
     fn to_tree_order(&self, values: &[Vec3]) -> Vec<Vec3> {
-        (0..self.len())
-            .into_par_iter()
-            .map(|t| values[self.tree.index(t) as usize])
-            .collect()
+        (0..self.len()).into_par_iter().map(|t| values[self.tree.index(t) as usize]).collect()
     }
 
     /// Per-point values given in tree order, in input order.
     fn to_input_order(&self, values: &[Vec3]) -> Vec<Vec3> {
-        self.position_of
-            .par_iter()
-            .map(|&t| values[t as usize])
-            .collect()
+        self.position_of.par_iter().map(|&t| values[t as usize]).collect()
     }
 
     /// Unoriented PCA normals in tree order, and how many points had a degenerate
     /// neighbourhood (filled from their neighbours, or `fallback` when none has a normal).
-    fn estimate(
-        &self,
-        fallback: Vec3,
-        threads: &Threads,
-        progress: &mut Progress,
-    ) -> Result<(Vec<Vec3>, usize)> {
+    fn estimate(&self, fallback: Vec3, threads: &Threads, progress: &mut Progress) -> Result<(Vec<Vec3>, usize)> {
         progress.report(0.5, "normals: PCA")?;
-        let mut normals: Vec<Vec3> = threads.run(|| {
-            (0..self.len())
-                .into_par_iter()
-                .map(|t| self.pca_normal(t).unwrap_or(Vec3::ZERO))
-                .collect()
-        });
+        let mut normals: Vec<Vec3> =
+            threads.run(|| (0..self.len()).into_par_iter().map(|t| self.pca_normal(t).unwrap_or(Vec3::ZERO)).collect());
         let degenerate = threads.run(|| self.fill_degenerate(&mut normals, fallback));
         Ok((normals, degenerate))
     }
@@ -476,9 +389,7 @@ impl Graph {
         mean /= count;
         let mut cov = Sym3::outer(mean);
         for &q in row {
-            cov.add(&Sym3::outer(
-                self.tree.point(q as usize).as_dvec3() - p - mean,
-            ));
+            cov.add(&Sym3::outer(self.tree.point(q as usize).as_dvec3() - p - mean));
         }
         let (values, normal) = least_spread(&cov);
         let floor = self.noise * self.noise * count;
@@ -492,20 +403,13 @@ impl Graph {
     /// (so a run of degenerate points fills from its ends); points in a part of the cloud
     /// with no normal at all get `fallback`. Returns how many were filled.
     fn fill_degenerate(&self, normals: &mut [Vec3], fallback: Vec3) -> usize {
-        let mut todo: Vec<u32> = (0..normals.len() as u32)
-            .filter(|&t| normals[t as usize] == Vec3::ZERO)
-            .collect();
+        let mut todo: Vec<u32> = (0..normals.len() as u32).filter(|&t| normals[t as usize] == Vec3::ZERO).collect();
         let count = todo.len();
         while !todo.is_empty() {
             // Jacobi-style rounds (read the previous round, then write) keep it deterministic.
             let found: Vec<Option<Vec3>> = todo
                 .par_iter()
-                .map(|&t| {
-                    self.row(t as usize)
-                        .iter()
-                        .map(|&q| normals[q as usize])
-                        .find(|&n| n != Vec3::ZERO)
-                })
+                .map(|&t| self.row(t as usize).iter().map(|&q| normals[q as usize]).find(|&n| n != Vec3::ZERO))
                 .collect();
             let before = todo.len();
             let mut left = Vec::new();
@@ -561,25 +465,17 @@ impl Graph {
         }
         progress.report(0.6, "normals: orientation graph")?;
         // Signs are decided on unit normals; the flips are applied to the normals as given.
-        let unit: Vec<Vec3> =
-            threads.run(|| normals.par_iter().map(|n| n.normalize_or_zero()).collect());
+        let unit: Vec<Vec3> = threads.run(|| normals.par_iter().map(|n| n.normalize_or_zero()).collect());
         let edges = self.sorted_edges(&unit, threads);
         progress.report(0.75, "normals: spanning forest")?;
         let parts = self.spanning_forest(&edges, &mut progress.stage(0.75, 0.95))?;
         drop(edges);
         progress.report(0.95, "normals: signs")?;
         let (root_flip, undecided) = self.component_signs(&parts, &unit, rule, threads);
-        let flips: Vec<bool> = (0..normals.len())
-            .map(|t| parts.flip[t] ^ root_flip[parts.component[t] as usize])
-            .collect();
-        let flipped = threads.run(|| {
-            normals
-                .par_iter_mut()
-                .zip(flips.par_iter())
-                .filter(|(_, &f)| f)
-                .map(|(n, _)| *n = -*n)
-                .count()
-        });
+        let flips: Vec<bool> =
+            (0..normals.len()).map(|t| parts.flip[t] ^ root_flip[parts.component[t] as usize]).collect();
+        let flipped = threads
+            .run(|| normals.par_iter_mut().zip(flips.par_iter()).filter(|(_, &f)| f).map(|(n, _)| *n = -*n).count());
         let mut sizes = vec![0usize; root_flip.len()];
         for &c in &parts.component {
             sizes[c as usize] += 1;
@@ -625,8 +521,7 @@ impl Graph {
                     let (nt, nu) = (normals[t], normals[u]);
                     let e = (self.tree.point(u) - self.tree.point(t)).normalize_or_zero();
                     let dot = nt.dot(nu);
-                    let w = 0.5 * (1.0 - dot.abs()).max(0.0)
-                        + 0.25 * (e.dot(nt).abs() + e.dot(nu).abs());
+                    let w = 0.5 * (1.0 - dot.abs()).max(0.0) + 0.25 * (e.dot(nt).abs() + e.dot(nu).abs());
                     // Weights are below 1.5, whose bucket 0x3FC0 leaves bit 15 free.
                     ((w.to_bits() >> WEIGHT_SHIFT) as u16) | if dot < 0.0 { 1 << 15 } else { 0 }
                 })
@@ -689,11 +584,7 @@ impl Graph {
             component[t] = numbering[root as usize];
             flip[t] = parity;
         }
-        Ok(Parts {
-            component,
-            flip,
-            count: components as usize,
-        })
+        Ok(Parts { component, flip, count: components as usize })
     }
 
     /// Whether each component must be flipped as a whole (after `parts.flip`), by `rule`, and
@@ -782,10 +673,7 @@ impl Graph {
         top.iter()
             .map(|&s| {
                 let n = oriented(s.expect("every component has a point"));
-                let decisive = [n.z, n.x, n.y]
-                    .into_iter()
-                    .find(|v| v.abs() > 1e-6)
-                    .unwrap_or(0.0);
+                let decisive = [n.z, n.x, n.y].into_iter().find(|v| v.abs() > 1e-6).unwrap_or(0.0);
                 decisive < 0.0
             })
             .collect()
@@ -808,13 +696,7 @@ impl Graph {
         let median = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
         // All-duplicate neighbourhoods have no area: give them the median (or 1 if that is 0).
         let typical = if median > 0.0 { median } else { 1.0 };
-        area.par_iter_mut().for_each(|a| {
-            *a = if *a > 0.0 {
-                a.min(16.0 * typical)
-            } else {
-                typical
-            }
-        });
+        area.par_iter_mut().for_each(|a| *a = if *a > 0.0 { a.min(16.0 * typical) } else { typical });
         area
     }
 }
@@ -847,14 +729,10 @@ fn least_spread(cov: &Sym3) -> ([f64; 3], DVec3) {
                 DVec3::new(xy, yy - smallest, yz),
                 DVec3::new(xz, yz, zz - smallest),
             ];
-            let best = [
-                rows[0].cross(rows[1]),
-                rows[0].cross(rows[2]),
-                rows[1].cross(rows[2]),
-            ]
-            .into_iter()
-            .max_by(|u, v| u.length_squared().total_cmp(&v.length_squared()))
-            .unwrap_or_default();
+            let best = [rows[0].cross(rows[1]), rows[0].cross(rows[2]), rows[1].cross(rows[2])]
+                .into_iter()
+                .max_by(|u, v| u.length_squared().total_cmp(&v.length_squared()))
+                .unwrap_or_default();
             if let Some(normal) = best.try_normalize() {
                 return ([largest, middle, smallest.max(0.0)], normal);
             }
@@ -887,10 +765,7 @@ const FLIP: u32 = 1 << 31;
 impl SignedForest {
     /// A forest of `n < 2^31` single points.
     fn new(n: usize) -> SignedForest {
-        SignedForest {
-            link: (0..n as u32).collect(),
-            rank: vec![0; n],
-        }
+        SignedForest { link: (0..n as u32).collect(), rank: vec![0; n] }
     }
 
     /// The root of `x`'s tree and whether `x`'s sign is opposite to the root's.
@@ -923,11 +798,7 @@ impl SignedForest {
         if ra == rb {
             return false;
         }
-        let (big, small) = if self.rank[ra as usize] >= self.rank[rb as usize] {
-            (ra, rb)
-        } else {
-            (rb, ra)
-        };
+        let (big, small) = if self.rank[ra as usize] >= self.rank[rb as usize] { (ra, rb) } else { (rb, ra) };
         // sign(a) ^ sign(b) = pa ^ pb ^ (sign of small relative to big) must equal `differ`.
         let flip = if pa ^ pb ^ differ { FLIP } else { 0 };
         self.link[small as usize] = big | flip;
@@ -948,18 +819,12 @@ mod tests {
         let mut rng = Rng::new(1);
         for case in 0..20_000 {
             // Random frames with spreads from isotropic to nearly flat and nearly linear.
-            let axis = |rng: &mut Rng| {
-                DVec3::new(rng.normal_f64(), rng.normal_f64(), rng.normal_f64()).normalize()
-            };
+            let axis = |rng: &mut Rng| DVec3::new(rng.normal_f64(), rng.normal_f64(), rng.normal_f64()).normalize();
             let u = axis(&mut rng);
             let v = u.cross(axis(&mut rng)).normalize();
             let w = u.cross(v);
             let scale = 10f64.powi(case % 13 - 6);
-            let s = [
-                1.0,
-                10f64.powf(-4.0 * rng.f64()),
-                10f64.powf(-9.0 * rng.f64()),
-            ];
+            let s = [1.0, 10f64.powf(-4.0 * rng.f64()), 10f64.powf(-9.0 * rng.f64())];
             let mut cov = Sym3::default();
             for (e, spread) in [u, v, w].into_iter().zip(s) {
                 cov.add(&Sym3::outer(e).scaled(spread * scale));
@@ -967,22 +832,13 @@ mod tests {
             let (values, normal) = least_spread(&cov);
             let (want_values, want) = cov.eigen();
             let want = want[2];
-            assert!(
-                normal.dot(want).abs() > 1.0 - 1e-9,
-                "{case}: {normal} vs {want}"
-            );
+            assert!(normal.dot(want).abs() > 1.0 - 1e-9, "{case}: {normal} vs {want}");
             for (a, b) in values.iter().zip(want_values) {
-                assert!(
-                    (a - b).abs() <= 1e-9 * want_values[0],
-                    "{values:?} {want_values:?}"
-                );
+                assert!((a - b).abs() <= 1e-9 * want_values[0], "{values:?} {want_values:?}");
             }
         }
         // Isotropic and zero matrices fall back to Jacobi.
-        assert_eq!(
-            least_spread(&Sym3([2.0, 0.0, 0.0, 2.0, 0.0, 2.0])).0,
-            [2.0; 3]
-        );
+        assert_eq!(least_spread(&Sym3([2.0, 0.0, 0.0, 2.0, 0.0, 2.0])).0, [2.0; 3]);
         assert_eq!(least_spread(&Sym3::default()).0, [0.0; 3]);
     }
 

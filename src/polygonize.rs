@@ -101,19 +101,13 @@ fn tetrahedron(
             // The triangle must face away from the single inside corner.
             let (i, o) = (ins[0], &outs);
             let flip = odd_tet ^ is_odd_permutation([i, o[0], o[1], o[2]]);
-            out.push(orient(
-                [edge(i, o[0]).0, edge(i, o[1]).0, edge(i, o[2]).0],
-                flip,
-            ));
+            out.push(orient([edge(i, o[0]).0, edge(i, o[1]).0, edge(i, o[2]).0], flip));
         }
         3 => {
             // The triangle must face towards the single outside corner.
             let (o, i) = (outs[0], &ins);
             let flip = !(odd_tet ^ is_odd_permutation([o, i[0], i[1], i[2]]));
-            out.push(orient(
-                [edge(o, i[0]).0, edge(o, i[1]).0, edge(o, i[2]).0],
-                flip,
-            ));
+            out.push(orient([edge(o, i[0]).0, edge(o, i[1]).0, edge(o, i[2]).0], flip));
         }
         2 => {
             // For a positive tet and an even (i, j, k, l) the quad ik, il, jl, jk faces the
@@ -154,11 +148,7 @@ impl Grid {
 
     fn unkey(key: u64) -> [u32; 3] {
         let mask = (1 << 21) - 1;
-        [
-            (key & mask) as u32,
-            (key >> 21 & mask) as u32,
-            (key >> 42) as u32,
-        ]
+        [(key & mask) as u32, (key >> 21 & mask) as u32, (key >> 42) as u32]
     }
 
     fn point(&self, [i, j, k]: [u32; 3]) -> Vec3 {
@@ -166,12 +156,7 @@ impl Grid {
     }
 
     fn on_border(&self, [i, j, k]: [u32; 3]) -> bool {
-        i == 0
-            || j == 0
-            || k == 0
-            || i + 1 >= self.dims[0]
-            || j + 1 >= self.dims[1]
-            || k + 1 >= self.dims[2]
+        i == 0 || j == 0 || k == 0 || i + 1 >= self.dims[0] || j + 1 >= self.dims[1] || k + 1 >= self.dims[2]
     }
 
     /// The cell containing `p` (clamped into the grid).
@@ -206,14 +191,7 @@ type FastMap<K, V> = HashMap<K, V, BuildHasherDefault<KeyHasher>>;
 type FastSet<K> = HashSet<K, BuildHasherDefault<KeyHasher>>;
 
 /// The six faces of a cube: the axis bit, and whether it is the face where that bit is set.
-const FACES: [(u8, bool); 6] = [
-    (1, false),
-    (1, true),
-    (2, false),
-    (2, true),
-    (4, false),
-    (4, true),
-];
+const FACES: [(u8, bool); 6] = [(1, false), (1, true), (2, false), (2, true), (4, false), (4, true)];
 
 /// Polygonises the part of the zero set of `f` (negative inside) that passes through the
 /// `seeds` cells, by surface tracking (Bloomenthal 1994): a cell is visited when it shares a
@@ -247,18 +225,12 @@ pub(crate) fn track_surface(
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let corner = |cell: [u32; 3], c: u8| {
-        [
-            cell[0] + u32::from(c & 1),
-            cell[1] + u32::from(c >> 1 & 1),
-            cell[2] + u32::from(c >> 2 & 1),
-        ]
+        [cell[0] + u32::from(c & 1), cell[1] + u32::from(c >> 1 & 1), cell[2] + u32::from(c >> 2 & 1)]
     };
 
     while !frontier.is_empty() {
         if visited.len() > max_cells {
-            return Err(Error::TooLarge(format!(
-                "the surface crosses more than {max_cells} grid cells"
-            )));
+            return Err(Error::TooLarge(format!("the surface crosses more than {max_cells} grid cells")));
         }
         // Evaluate the corners not seen yet, in parallel.
         let mut needed: Vec<u64> = frontier
@@ -322,10 +294,8 @@ pub(crate) fn track_surface(
                 &mut triangles,
             );
             for (bit, upper) in FACES {
-                let face: Vec<bool> = (0..8u8)
-                    .filter(|k| (k & bit != 0) == upper)
-                    .map(|k| inside[k as usize])
-                    .collect();
+                let face: Vec<bool> =
+                    (0..8u8).filter(|k| (k & bit != 0) == upper).map(|k| inside[k as usize]).collect();
                 if face.iter().all(|&x| x == face[0]) {
                     continue;
                 }
@@ -349,11 +319,7 @@ pub(crate) fn track_surface(
     if positions.len() >= u32::MAX as usize {
         return Err(Error::TooLarge("more than 2^32 vertices".into()));
     }
-    Ok(Mesh {
-        positions,
-        normals: None,
-        triangles,
-    })
+    Ok(Mesh { positions, normals: None, triangles })
 }
 
 #[cfg(test)]
@@ -369,13 +335,7 @@ mod tests {
                 assert_eq!((w[1] & w[0]), w[0], "{corners:?} is not monotone");
                 assert_eq!((w[1] ^ w[0]).count_ones(), 1);
             }
-            let v = corners.map(|c| {
-                Vec3::new(
-                    f32::from(c & 1),
-                    f32::from((c >> 1) & 1),
-                    f32::from((c >> 2) & 1),
-                )
-            });
+            let v = corners.map(|c| Vec3::new(f32::from(c & 1), f32::from((c >> 1) & 1), f32::from((c >> 2) & 1)));
             let det = (v[1] - v[0]).dot((v[2] - v[0]).cross(v[3] - v[0]));
             assert_eq!(det < 0.0, odd, "{corners:?}");
         }
@@ -388,47 +348,28 @@ mod tests {
 
     #[test]
     fn tracking_from_one_seed_finds_the_whole_closed_surface() {
-        let grid = Grid {
-            origin: Vec3::splat(-1.6),
-            cell: 0.05,
-            dims: [65, 65, 65],
-        };
+        let grid = Grid { origin: Vec3::splat(-1.6), cell: 0.05, dims: [65, 65, 65] };
         // One seed cell on the torus' outer equator.
         let seed = grid.cell_of(Vec3::new(1.33, 0.01, 0.01));
-        let mesh =
-            track_surface(&torus, &grid, &[seed], 1 << 20, &Threads::new(0).unwrap()).unwrap();
+        let mesh = track_surface(&torus, &grid, &[seed], 1 << 20, &Threads::new(0).unwrap()).unwrap();
         let report = analyze(&mesh);
         assert!(report.is_watertight(), "{report:?}");
         assert_eq!(report.genus(), Some(1));
         assert_eq!(report.components, 1);
         let volume = signed_volume(&mesh);
         let exact = 2.0 * std::f64::consts::PI.powi(2) * 1.0 * 0.35f64.powi(2);
-        assert!(
-            (volume / exact - 1.0).abs() < 0.02,
-            "volume {volume} vs {exact}"
-        );
+        assert!((volume / exact - 1.0).abs() < 0.02, "volume {volume} vs {exact}");
         // Same mesh as the dense polygoniser on the same grid.
-        let dense =
-            crate::shapes::implicit_mesh(torus, grid.origin, grid.origin + grid.cell * 64.0, 64);
+        let dense = crate::shapes::implicit_mesh(torus, grid.origin, grid.origin + grid.cell * 64.0, 64);
         assert_eq!(dense.triangles.len(), mesh.triangles.len());
     }
 
     #[test]
     fn a_surface_leaving_the_grid_is_closed_at_its_border_and_seeds_outside_are_ignored() {
-        let grid = Grid {
-            origin: Vec3::splat(-1.0),
-            cell: 0.1,
-            dims: [21, 21, 21],
-        };
+        let grid = Grid { origin: Vec3::splat(-1.0), cell: 0.1, dims: [21, 21, 21] };
         let plane = |p: Vec3| p.z;
-        let mesh = track_surface(
-            &plane,
-            &grid,
-            &[[10, 10, 9], [99, 0, 0]],
-            1 << 20,
-            &Threads::new(1).unwrap(),
-        )
-        .unwrap();
+        let mesh =
+            track_surface(&plane, &grid, &[[10, 10, 9], [99, 0, 0]], 1 << 20, &Threads::new(1).unwrap()).unwrap();
         assert!(analyze(&mesh).is_watertight());
         let too_small = track_surface(&plane, &grid, &[[10, 10, 9]], 10, &Threads::new(1).unwrap());
         assert!(matches!(too_small, Err(Error::TooLarge(_))));

@@ -17,19 +17,11 @@ pub struct Progress<'a> {
 impl<'a> Progress<'a> {
     /// No reporting, never cancelled.
     pub fn none() -> Progress<'static> {
-        Progress {
-            callback: None,
-            start: 0.0,
-            end: 1.0,
-        }
+        Progress { callback: None, start: 0.0, end: 1.0 }
     }
 
     pub fn new(callback: &'a mut ProgressFn<'a>) -> Progress<'a> {
-        Progress {
-            callback: Some(callback),
-            start: 0.0,
-            end: 1.0,
-        }
+        Progress { callback: Some(callback), start: 0.0, end: 1.0 }
     }
 
     /// Reports `fraction` of the current stage; `Err(Cancelled)` when the callback says stop.
@@ -50,10 +42,7 @@ impl<'a> Progress<'a> {
     pub fn stage(&mut self, from: f32, to: f32) -> Progress<'_> {
         let span = self.end - self.start;
         Progress {
-            callback: self
-                .callback
-                .as_mut()
-                .map(|c| &mut **c as &mut ProgressFn<'_>),
+            callback: self.callback.as_mut().map(|c| &mut **c as &mut ProgressFn<'_>),
             start: self.start + span * from,
             end: self.start + span * to,
         }
@@ -69,10 +58,7 @@ pub struct Threads {
 impl Threads {
     pub fn new(count: usize) -> Result<Threads> {
         if count > 1024 {
-            return Err(Error::param(
-                "threads",
-                format!("{count} is absurd (0 = all cores, at most 1024)"),
-            ));
+            return Err(Error::param("threads", format!("{count} is absurd (0 = all cores, at most 1024)")));
         }
         let pool = match count {
             0 => None,

@@ -144,23 +144,13 @@ mod tests {
 
     #[test]
     fn two_parallel_sheets_have_half_gap_error() {
-        let s = stats(&[
-            (DVec3::new(0.0, 0.0, 0.0), DVec3::Z),
-            (DVec3::new(0.0, 0.0, 1.0), DVec3::Z),
-        ]);
+        let s = stats(&[(DVec3::new(0.0, 0.0, 0.0), DVec3::Z), (DVec3::new(0.0, 0.0, 1.0), DVec3::Z)]);
         assert!((s.l2_error() - 0.5).abs() < 1e-12); // 2 × 0.5²
     }
 
     #[test]
     fn sphere_samples_have_radius_error_and_centre_minimiser() {
-        let dirs = [
-            DVec3::X,
-            -DVec3::X,
-            DVec3::Y,
-            -DVec3::Y,
-            DVec3::Z,
-            -DVec3::Z,
-        ];
+        let dirs = [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z, -DVec3::Z];
         let s = stats(&dirs.map(|d| (d * 2.0, d)));
         assert!(s.quadric_minimizer().length() < 1e-12);
         assert!((s.l2_error() - 24.0).abs() < 1e-12); // 6 × 2²

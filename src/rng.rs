@@ -36,10 +36,7 @@ pub fn stream_seed(seed: u64, stream: u64) -> u64 {
 impl Rng {
     /// A generator seeded with `seed`; equal seeds give equal sequences.
     pub fn new(seed: u64) -> Rng {
-        Rng {
-            state: seed,
-            spare_normal: None,
-        }
+        Rng { state: seed, spare_normal: None }
     }
 
     /// The next 64 uniformly distributed bits.

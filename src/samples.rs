@@ -45,9 +45,7 @@ impl SampleSet {
             MeshSampling::FaceCenters => face_samples(mesh),
         };
         if samples.is_empty() {
-            return Err(Error::input(
-                "every triangle of the mesh is degenerate (zero area)",
-            ));
+            return Err(Error::input("every triangle of the mesh is degenerate (zero area)"));
         }
         Ok(samples)
     }
@@ -85,11 +83,7 @@ fn area_normal(mesh: &Mesh, tri: &[u32; 3]) -> Vec3 {
 fn vertex_samples(mesh: &Mesh) -> SampleSet {
     let mut sums = vec![Vec3::ZERO; mesh.positions.len()];
     let mut used = vec![false; mesh.positions.len()];
-    for tri in mesh
-        .triangles
-        .iter()
-        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
-    {
+    for tri in mesh.triangles.iter().filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) {
         let n = area_normal(mesh, tri);
         if n == Vec3::ZERO {
             continue; // zero area: no orientation, no sample
@@ -132,13 +126,7 @@ mod tests {
 
     fn quad() -> Mesh {
         Mesh {
-            positions: vec![
-                Vec3::ZERO,
-                Vec3::X,
-                Vec3::new(1.0, 1.0, 0.0),
-                Vec3::Y,
-                Vec3::splat(9.0),
-            ],
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y, Vec3::splat(9.0)],
             normals: None,
             triangles: vec![[0, 1, 2], [0, 2, 3], [0, 0, 1]],
         }

@@ -85,11 +85,7 @@ pub fn icosphere(radius: f32, subdivisions: u32) -> Mesh {
         triangles = finer;
     }
     let radius = radius.abs();
-    Mesh {
-        positions: directions.iter().map(|&d| d * radius).collect(),
-        normals: Some(directions),
-        triangles,
-    }
+    Mesh { positions: directions.iter().map(|&d| d * radius).collect(), normals: Some(directions), triangles }
 }
 
 /// A torus around the z axis, centred at the origin: the tube of radius `minor` around the
@@ -99,10 +95,7 @@ pub fn icosphere(radius: f32, subdivisions: u32) -> Mesh {
 /// With `minor >= major` the tube self-intersects; the mesh is still combinatorially a torus.
 pub fn torus(major: f32, minor: f32, major_segments: u32, minor_segments: u32) -> Mesh {
     // The clamp keeps m * n (the vertex count) within u32.
-    let (m, n) = (
-        major_segments.clamp(3, 1 << 15),
-        minor_segments.clamp(3, 1 << 15),
-    );
+    let (m, n) = (major_segments.clamp(3, 1 << 15), minor_segments.clamp(3, 1 << 15));
     let mut positions = Vec::with_capacity((m * n) as usize);
     let mut normals = Vec::with_capacity((m * n) as usize);
     for i in 0..m {
@@ -120,20 +113,11 @@ pub fn torus(major: f32, minor: f32, major_segments: u32, minor_segments: u32) -
     for i in 0..m {
         for j in 0..n {
             // d/du x d/dv points outward, so (i, j) -> (i+1, j) -> (i+1, j+1) is counter-clockwise.
-            let (a, b, c, d) = (
-                index(i, j),
-                index(i + 1, j),
-                index(i + 1, j + 1),
-                index(i, j + 1),
-            );
+            let (a, b, c, d) = (index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1));
             triangles.extend([[a, b, c], [a, c, d]]);
         }
     }
-    Mesh {
-        positions,
-        normals: Some(normals),
-        triangles,
-    }
+    Mesh { positions, normals: Some(normals), triangles }
 }
 
 /// The radius of [`bumpy_sphere`] in the unit direction `direction`:
@@ -219,9 +203,7 @@ pub fn genus_n_pretzel(n: u32) -> Mesh {
     let half_height = small + 0.15;
     let max = Vec3::new(half_width, half_depth, half_height);
     let resolution = (2.0 * half_width * PRETZEL_CELLS_PER_UNIT).ceil() as u32;
-    let centers: Vec<Vec3> = (0..n)
-        .map(|i| Vec3::X * big * (2.0 * i as f32 - (n as f32 - 1.0)))
-        .collect();
+    let centers: Vec<Vec3> = (0..n).map(|i| Vec3::X * big * (2.0 * i as f32 - (n as f32 - 1.0))).collect();
     let f = |p: Vec3| {
         if centers.is_empty() {
             // An ellipsoid with semi-axes (R + r, R + r, r); not a distance, but a fine implicit.
@@ -265,11 +247,7 @@ impl Grid {
 
     /// Index offset of corner `c` (bits x = 1, y = 2, z = 4) from corner 0.
     fn corner_offset(&self, c: u8) -> usize {
-        self.point_index(
-            usize::from(c & 1),
-            usize::from((c >> 1) & 1),
-            usize::from((c >> 2) & 1),
-        )
+        self.point_index(usize::from(c & 1), usize::from((c >> 1) & 1), usize::from((c >> 2) & 1))
     }
 
     /// Vertex on the crossing edge from point `p` to the point offset by corner `d` (d > 0).
@@ -293,12 +271,7 @@ impl Grid {
 ///
 /// Evaluation and triangulation run in parallel over z-slabs; the output is identical for any
 /// number of threads. A box with a non-finite corner or zero extent gives an empty mesh.
-pub fn implicit_mesh(
-    f: impl Fn(Vec3) -> f32 + Sync,
-    min: Vec3,
-    max: Vec3,
-    resolution: u32,
-) -> Mesh {
+pub fn implicit_mesh(f: impl Fn(Vec3) -> f32 + Sync, min: Vec3, max: Vec3, resolution: u32) -> Mesh {
     let (lo, hi) = (min.min(max), min.max(max));
     let extent = hi - lo;
     let longest = extent.max_element();
@@ -308,11 +281,7 @@ pub fn implicit_mesh(
     let resolution = resolution.clamp(1, MAX_RESOLUTION);
     let cell = longest / resolution as f32;
     let cells_along = |e: f32| ((e / cell).ceil() as usize).clamp(1, resolution as usize);
-    let dims = [
-        cells_along(extent.x) + 1,
-        cells_along(extent.y) + 1,
-        cells_along(extent.z) + 1,
-    ];
+    let dims = [cells_along(extent.x) + 1, cells_along(extent.y) + 1, cells_along(extent.z) + 1];
     let plane = dims[0] * dims[1];
     let mut grid = Grid {
         dims,
@@ -357,11 +326,7 @@ pub fn implicit_mesh(
                     let mut bits = 0u8;
                     first.push(positions.len() as u32);
                     for d in 1u8..8 {
-                        let (di, dj, dk) = (
-                            usize::from(d & 1),
-                            usize::from((d >> 1) & 1),
-                            usize::from((d >> 2) & 1),
-                        );
+                        let (di, dj, dk) = (usize::from(d & 1), usize::from((d >> 1) & 1), usize::from((d >> 2) & 1));
                         if i + di >= dims[0] || j + dj >= dims[1] || k + dk >= dims[2] {
                             continue;
                         }
@@ -385,10 +350,7 @@ pub fn implicit_mesh(
     for (k, (crossings, first, plane_positions)) in planes.into_iter().enumerate() {
         let offset = positions.len() as u32;
         grid.crossings[k * plane..(k + 1) * plane].copy_from_slice(&crossings);
-        for (dst, src) in grid.first_vertex[k * plane..(k + 1) * plane]
-            .iter_mut()
-            .zip(first)
-        {
+        for (dst, src) in grid.first_vertex[k * plane..(k + 1) * plane].iter_mut().zip(first) {
             *dst = src + offset;
         }
         positions.extend(plane_positions);
@@ -404,9 +366,8 @@ pub fn implicit_mesh(
             for j in 0..dims[1] - 1 {
                 for i in 0..dims[0] - 1 {
                     let base = grid.point_index(i, j, k);
-                    let inside: [bool; 8] = std::array::from_fn(|c| {
-                        grid.values[base + grid.corner_offset(c as u8)] < 0.0
-                    });
+                    let inside: [bool; 8] =
+                        std::array::from_fn(|c| grid.values[base + grid.corner_offset(c as u8)] < 0.0);
                     if inside.iter().all(|&x| x == inside[0]) {
                         continue;
                     }
@@ -438,11 +399,7 @@ pub fn implicit_mesh(
             g.normalize_or_zero()
         })
         .collect();
-    let mut mesh = Mesh {
-        positions,
-        normals: None,
-        triangles,
-    };
+    let mut mesh = Mesh { positions, normals: None, triangles };
     if normals.contains(&Vec3::ZERO) {
         let fallback = area_weighted_normals(&mesh);
         for (n, alt) in normals.iter_mut().zip(fallback) {
@@ -481,16 +438,8 @@ impl AliasTable {
         let total: f64 = weights.iter().sum();
         // Scaled so the mean is 1; slots below 1 are topped up from slots above 1.
         let mut scaled: Vec<f64> = weights.iter().map(|w| w * n as f64 / total).collect();
-        let mut slots: Vec<AliasSlot> = items
-            .iter()
-            .map(|&own| AliasSlot {
-                keep: 1.0,
-                own,
-                alias: own,
-            })
-            .collect();
-        let (mut small, mut large): (Vec<usize>, Vec<usize>) =
-            (0..n).partition(|&i| scaled[i] < 1.0);
+        let mut slots: Vec<AliasSlot> = items.iter().map(|&own| AliasSlot { keep: 1.0, own, alias: own }).collect();
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| scaled[i] < 1.0);
         while let (Some(s), Some(&l)) = (small.pop(), large.last()) {
             slots[s].keep = scaled[s];
             slots[s].alias = items[l];
@@ -552,11 +501,8 @@ pub fn sample_surface(mesh: &Mesh, count: usize, seed: u64) -> Mesh {
 
     let mut positions = vec![Vec3::ZERO; count];
     let mut normals = vec![Vec3::ZERO; count];
-    positions
-        .par_chunks_mut(CHUNK)
-        .zip(normals.par_chunks_mut(CHUNK))
-        .enumerate()
-        .for_each(|(chunk, (positions, normals))| {
+    positions.par_chunks_mut(CHUNK).zip(normals.par_chunks_mut(CHUNK)).enumerate().for_each(
+        |(chunk, (positions, normals))| {
             let mut rng = Rng::new(stream_seed(seed, chunk as u64));
             for (position, normal) in positions.iter_mut().zip(normals) {
                 let tri = mesh.triangles[table.draw(rng.next_u64()) as usize];
@@ -567,14 +513,13 @@ pub fn sample_surface(mesh: &Mesh, count: usize, seed: u64) -> Mesh {
                 *position = a * w[0] + b * w[1] + c * w[2];
                 let face = (b - a).cross(c - a).normalize_or(Vec3::Z);
                 *normal = match vertex_normals {
-                    Some(n) => (n[tri[0] as usize] * w[0]
-                        + n[tri[1] as usize] * w[1]
-                        + n[tri[2] as usize] * w[2])
+                    Some(n) => (n[tri[0] as usize] * w[0] + n[tri[1] as usize] * w[1] + n[tri[2] as usize] * w[2])
                         .normalize_or(face),
                     None => face,
                 };
             }
-        });
+        },
+    );
     Mesh::from_points(positions, Some(normals))
 }
 
@@ -590,33 +535,26 @@ pub fn sample_surface(mesh: &Mesh, count: usize, seed: u64) -> Mesh {
 pub fn add_noise(cloud: &mut Mesh, position_sigma: f32, normal_sigma_radians: f32, seed: u64) {
     let usable = |s: f32| s.is_finite() && s > 0.0;
     if usable(position_sigma) {
-        cloud
-            .positions
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(chunk, positions)| {
-                let mut rng = Rng::new(stream_seed(seed, 2 * chunk as u64));
-                for p in positions {
-                    *p += Vec3::new(rng.normal(), rng.normal(), rng.normal()) * position_sigma;
-                }
-            });
+        cloud.positions.par_chunks_mut(CHUNK).enumerate().for_each(|(chunk, positions)| {
+            let mut rng = Rng::new(stream_seed(seed, 2 * chunk as u64));
+            for p in positions {
+                *p += Vec3::new(rng.normal(), rng.normal(), rng.normal()) * position_sigma;
+            }
+        });
     }
     if let (Some(normals), true) = (cloud.normals.as_mut(), usable(normal_sigma_radians)) {
-        normals
-            .par_chunks_mut(CHUNK)
-            .enumerate()
-            .for_each(|(chunk, normals)| {
-                let mut rng = Rng::new(stream_seed(seed, 2 * chunk as u64 + 1));
-                for n in normals {
-                    // Draw even for skipped normals so each normal's noise depends on its index only.
-                    let (g1, g2) = (rng.normal(), rng.normal());
-                    let Some(unit) = n.try_normalize() else {
-                        continue;
-                    };
-                    let (t1, t2) = unit.any_orthonormal_pair();
-                    *n = (unit + (t1 * g1 + t2 * g2) * normal_sigma_radians).normalize_or(unit);
-                }
-            });
+        normals.par_chunks_mut(CHUNK).enumerate().for_each(|(chunk, normals)| {
+            let mut rng = Rng::new(stream_seed(seed, 2 * chunk as u64 + 1));
+            for n in normals {
+                // Draw even for skipped normals so each normal's noise depends on its index only.
+                let (g1, g2) = (rng.normal(), rng.normal());
+                let Some(unit) = n.try_normalize() else {
+                    continue;
+                };
+                let (t1, t2) = unit.any_orthonormal_pair();
+                *n = (unit + (t1 * g1 + t2 * g2) * normal_sigma_radians).normalize_or(unit);
+            }
+        });
     }
 }
 
@@ -627,12 +565,7 @@ mod tests {
 
     #[test]
     fn implicit_sphere_is_watertight_and_outward() {
-        let m = implicit_mesh(
-            |p| p.length() - 1.0,
-            Vec3::splat(-1.3),
-            Vec3::splat(1.3),
-            20,
-        );
+        let m = implicit_mesh(|p| p.length() - 1.0, Vec3::splat(-1.3), Vec3::splat(1.3), 20);
         let r = analyze(&m);
         assert!(r.is_watertight(), "{r:?}");
         assert_eq!(r.genus(), Some(0));
@@ -647,22 +580,11 @@ mod tests {
 
     #[test]
     fn implicit_degenerate_inputs() {
-        assert!(
-            implicit_mesh(|p| p.length() - 1.0, Vec3::ONE, Vec3::ONE, 10)
-                .positions
-                .is_empty()
-        );
-        assert!(implicit_mesh(|_| f32::NAN, Vec3::ZERO, Vec3::ONE, 4)
-            .triangles
-            .is_empty());
+        assert!(implicit_mesh(|p| p.length() - 1.0, Vec3::ONE, Vec3::ONE, 10).positions.is_empty());
+        assert!(implicit_mesh(|_| f32::NAN, Vec3::ZERO, Vec3::ONE, 4).triangles.is_empty());
         // Zero exactly at grid points (the plane z = 0 through a grid layer) still gives a
         // manifold surface with no coincident vertices.
-        let m = implicit_mesh(
-            |p| (p.length() - 1.0).max(-p.z),
-            Vec3::splat(-1.5),
-            Vec3::splat(1.5),
-            12,
-        );
+        let m = implicit_mesh(|p| (p.length() - 1.0).max(-p.z), Vec3::splat(-1.5), Vec3::splat(1.5), 12);
         let r = analyze(&m);
         assert!(r.is_watertight(), "{r:?}");
     }
@@ -691,24 +613,12 @@ mod tests {
         let n = 100_000;
         let mut cloud = Mesh::from_points(vec![Vec3::ZERO; n], Some(vec![Vec3::Z; n]));
         add_noise(&mut cloud, 0.01, 0.05, 3);
-        let var = cloud
-            .positions
-            .iter()
-            .map(|p| p.length_squared())
-            .sum::<f32>()
-            / (3 * n) as f32;
+        let var = cloud.positions.iter().map(|p| p.length_squared()).sum::<f32>() / (3 * n) as f32;
         assert!((var.sqrt() - 0.01).abs() < 2e-4, "sigma {}", var.sqrt());
         let normals = cloud.normals.unwrap();
-        let mean_angle = normals
-            .iter()
-            .map(|v| v.z.clamp(-1.0, 1.0).acos())
-            .sum::<f32>()
-            / n as f32;
+        let mean_angle = normals.iter().map(|v| v.z.clamp(-1.0, 1.0).acos()).sum::<f32>() / n as f32;
         let expected = 0.05 * (std::f32::consts::PI / 2.0).sqrt();
-        assert!(
-            (mean_angle - expected).abs() < 0.02 * expected,
-            "{mean_angle} vs {expected}"
-        );
+        assert!((mean_angle - expected).abs() < 0.02 * expected, "{mean_angle} vs {expected}");
         assert!(normals.iter().all(|v| (v.length() - 1.0).abs() < 1e-5));
     }
 }

@@ -55,24 +55,15 @@ pub const NO_CLUSTER: u32 = u32::MAX;
 pub fn cluster(tree: &VsTree, threads: &Threads) -> Clustering {
     let leaves: Vec<u32> = tree.leaves().map(|i| i as u32).collect();
     let origin = tree.root().center.as_dvec3();
-    let (representatives, normals): (Vec<Vec3>, Vec<Vec3>) = threads.run(|| {
-        leaves
-            .par_iter()
-            .map(|&leaf| representative(tree, leaf as usize, origin))
-            .unzip()
-    });
+    let (representatives, normals): (Vec<Vec3>, Vec<Vec3>) =
+        threads.run(|| leaves.par_iter().map(|&leaf| representative(tree, leaf as usize, origin)).unzip());
     let mut sample_cluster = vec![NO_CLUSTER; tree.samples.len()];
     for (k, &leaf) in leaves.iter().enumerate() {
         for s in tree.samples_of(&tree.nodes[leaf as usize]) {
             sample_cluster[s.index as usize] = k as u32;
         }
     }
-    Clustering {
-        representatives,
-        normals,
-        leaves,
-        sample_cluster,
-    }
+    Clustering { representatives, normals, leaves, sample_cluster }
 }
 
 /// A leaf's representative (see [`tree::representative`]) and its mean normal.
@@ -84,33 +75,18 @@ fn representative(tree: &VsTree, leaf: usize, origin: DVec3) -> (Vec3, Vec3) {
     }
     let frame = (node.kind == NodeKind::Surface).then(|| &tree.frames[node.frame as usize]);
     let x = tree::representative(node, frame, &stats, origin);
-    (
-        x.as_vec3(),
-        stats.mean_normal().normalize_or_zero().as_vec3(),
-    )
+    (x.as_vec3(), stats.mean_normal().normalize_or_zero().as_vec3())
 }
 
 /// Simplifies `mesh` (or a point cloud with normals) by clustering in the tree `params`
 /// describe. Returns the simplified mesh and what was done.
-pub fn simplify(
-    mesh: &Mesh,
-    params: &SimplifyParams,
-    progress: &mut Progress,
-) -> Result<(Mesh, SimplifyStats)> {
+pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> Result<(Mesh, SimplifyStats)> {
     let threads = Threads::new(params.threads)?;
     let t0 = Instant::now();
-    let samples = if mesh.is_point_cloud() {
-        SampleSet::from_cloud(mesh)?
-    } else {
-        SampleSet::from_mesh(mesh, params.sampling)?
-    };
+    let samples =
+        if mesh.is_point_cloud() { SampleSet::from_cloud(mesh)? } else { SampleSet::from_mesh(mesh, params.sampling)? };
     let t1 = Instant::now();
-    let tree = tree::build(
-        &samples,
-        &params.tree,
-        &threads,
-        &mut progress.stage(0.0, 0.8),
-    )?;
+    let tree = tree::build(&samples, &params.tree, &threads, &mut progress.stage(0.0, 0.8))?;
     let t2 = Instant::now();
     progress.report(0.8, "clustering")?;
     let clusters = cluster(&tree, &threads);
@@ -164,10 +140,7 @@ pub fn vertex_labels(
                 while !tree.nodes[i].is_leaf() {
                     i = tree.nodes[i].first_child as usize;
                 }
-                clusters
-                    .leaves
-                    .binary_search(&(i as u32))
-                    .map_or(NO_CLUSTER, |k| k as u32)
+                clusters.leaves.binary_search(&(i as u32)).map_or(NO_CLUSTER, |k| k as u32)
             };
             for tri in &mesh.triangles {
                 for &v in tri {
@@ -185,12 +158,7 @@ pub fn vertex_labels(
 
 /// Re-indexes triangles to clusters, drops collapsed ones and repeats (the first of a repeated
 /// triangle is kept, with its winding), and keeps only the representatives still used.
-fn collapse(
-    mesh: &Mesh,
-    labels: &[u32],
-    representatives: &[Vec3],
-    threads: &Threads,
-) -> Result<Mesh> {
+fn collapse(mesh: &Mesh, labels: &[u32], representatives: &[Vec3], threads: &Threads) -> Result<Mesh> {
     let (triangles, used) = threads.run(|| {
         let mut keyed: Vec<([u32; 3], u32)> = mesh
             .triangles
@@ -214,10 +182,8 @@ fn collapse(
             .map(|(_, (_, t))| *t)
             .collect();
         kept.par_sort_unstable();
-        let triangles: Vec<[u32; 3]> = kept
-            .iter()
-            .map(|&t| mesh.triangles[t as usize].map(|v| labels[v as usize]))
-            .collect();
+        let triangles: Vec<[u32; 3]> =
+            kept.iter().map(|&t| mesh.triangles[t as usize].map(|v| labels[v as usize])).collect();
         let mut used = vec![false; representatives.len()];
         for tri in &triangles {
             for &c in tri {
@@ -232,16 +198,9 @@ fn collapse(
         new_index[c] = positions.len() as u32;
         positions.push(representatives[c]);
     }
-    let triangles: Vec<[u32; 3]> = triangles
-        .into_iter()
-        .map(|t| t.map(|c| new_index[c as usize]))
-        .collect();
+    let triangles: Vec<[u32; 3]> = triangles.into_iter().map(|t| t.map(|c| new_index[c as usize])).collect();
     if positions.len() > u32::MAX as usize {
         return Err(Error::TooLarge("output vertices".into()));
     }
-    Ok(Mesh {
-        positions,
-        normals: None,
-        triangles,
-    })
+    Ok(Mesh { positions, normals: None, triangles })
 }

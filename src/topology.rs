@@ -84,10 +84,7 @@ struct UnionFind {
 
 impl UnionFind {
     fn new(n: usize) -> UnionFind {
-        UnionFind {
-            parent: (0..n as u32).collect(),
-            size: vec![1; n],
-        }
+        UnionFind { parent: (0..n as u32).collect(), size: vec![1; n] }
     }
 
     fn find(&mut self, mut x: u32) -> u32 {
@@ -114,10 +111,7 @@ impl UnionFind {
 
 /// True when `tri` has three distinct indices below `vertex_count`.
 fn is_valid_face(tri: &[u32; 3], vertex_count: usize) -> bool {
-    tri.iter().all(|&v| (v as usize) < vertex_count)
-        && tri[0] != tri[1]
-        && tri[1] != tri[2]
-        && tri[0] != tri[2]
+    tri.iter().all(|&v| (v as usize) < vertex_count) && tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2]
 }
 
 /// One directed half-edge: the undirected key (low index in the high 32 bits), and the face index
@@ -154,20 +148,11 @@ fn sorted_half_edges(faces: &[[u32; 3]]) -> Vec<HalfEdge> {
 pub fn analyze(mesh: &Mesh) -> TopologyReport {
     let n_vertices = mesh.positions.len();
     // From here on faces are numbered by their rank among the valid faces.
-    let faces: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .filter(|tri| is_valid_face(tri, n_vertices))
-        .copied()
-        .collect();
+    let faces: Vec<[u32; 3]> = mesh.triangles.iter().filter(|tri| is_valid_face(tri, n_vertices)).copied().collect();
     let degenerate_faces = mesh.triangles.len() - faces.len();
     let half_edges = sorted_half_edges(&faces);
 
-    let mut report = TopologyReport {
-        faces: faces.len(),
-        degenerate_faces,
-        ..TopologyReport::default()
-    };
+    let mut report = TopologyReport { faces: faces.len(), degenerate_faces, ..TopologyReport::default() };
     let mut components = UnionFind::new(faces.len());
     // The first half-edge of every undirected edge, for counting edges per component.
     let mut edge_first_faces: Vec<u32> = Vec::new();
@@ -214,9 +199,7 @@ pub fn analyze(mesh: &Mesh) -> TopologyReport {
         }
     }
 
-    report.vertices = (0..n_vertices)
-        .filter(|&v| row_start[v + 1] > row_start[v])
-        .count();
+    report.vertices = (0..n_vertices).filter(|&v| row_start[v + 1] > row_start[v]).count();
     report.unreferenced_vertices = n_vertices - report.vertices;
     report.non_manifold_vertices = (0..n_vertices)
         .into_par_iter()
@@ -225,8 +208,7 @@ pub fn analyze(mesh: &Mesh) -> TopologyReport {
             !fan.is_empty() && (on_non_manifold_edge[v] || !is_single_fan(v as u32, fan, &faces))
         })
         .count();
-    report.euler_characteristic =
-        report.vertices as i64 - report.edges as i64 + report.faces as i64;
+    report.euler_characteristic = report.vertices as i64 - report.edges as i64 + report.faces as i64;
 
     // Per-component Euler characteristics, components numbered by their first face.
     let mut component_of_root = vec![u32::MAX; faces.len()];
@@ -287,12 +269,8 @@ fn is_single_fan(v: u32, fan: &[u32], faces: &[[u32; 3]]) -> bool {
 /// The valence (number of distinct neighbours along edges) of every vertex in `positions`;
 /// unreferenced vertices have valence 0. Degenerate faces are ignored.
 pub fn valences(mesh: &Mesh) -> Vec<u32> {
-    let faces: Vec<[u32; 3]> = mesh
-        .triangles
-        .iter()
-        .filter(|tri| is_valid_face(tri, mesh.positions.len()))
-        .copied()
-        .collect();
+    let faces: Vec<[u32; 3]> =
+        mesh.triangles.iter().filter(|tri| is_valid_face(tri, mesh.positions.len())).copied().collect();
     let mut valence = vec![0u32; mesh.positions.len()];
     for run in sorted_half_edges(&faces).chunk_by(|a, b| a.key == b.key) {
         valence[(run[0].key >> 32) as usize] += 1;
@@ -323,11 +301,7 @@ pub fn signed_volume(mesh: &Mesh) -> f64 {
         .iter()
         .filter(|tri| tri.iter().all(|&v| (v as usize) < p.len()))
         .map(|&[a, b, c]| {
-            let (a, b, c) = (
-                p[a as usize].as_dvec3(),
-                p[b as usize].as_dvec3(),
-                p[c as usize].as_dvec3(),
-            );
+            let (a, b, c) = (p[a as usize].as_dvec3(), p[b as usize].as_dvec3(), p[c as usize].as_dvec3());
             a.dot(b.cross(c))
         })
         .sum::<f64>()
@@ -343,9 +317,7 @@ pub fn surface_area(mesh: &Mesh) -> f64 {
         .filter(|tri| tri.iter().all(|&v| (v as usize) < p.len()))
         .map(|&[a, b, c]| {
             let a = p[a as usize].as_dvec3();
-            (p[b as usize].as_dvec3() - a)
-                .cross(p[c as usize].as_dvec3() - a)
-                .length()
+            (p[b as usize].as_dvec3() - a).cross(p[c as usize].as_dvec3() - a).length()
         })
         .sum::<f64>()
         / 2.0
@@ -407,8 +379,7 @@ mod tests {
         let mut m = tetrahedron();
         m.positions.extend([-Vec3::X, -Vec3::Y, -Vec3::Z]);
         // A second tetrahedron (0, 4, 5, 6), mirrored so its winding is outward too.
-        m.triangles
-            .extend([[0, 4, 5], [0, 6, 4], [0, 5, 6], [4, 6, 5]]);
+        m.triangles.extend([[0, 4, 5], [0, 6, 4], [0, 5, 6], [4, 6, 5]]);
         let r = analyze(&m);
         assert_eq!(r.non_manifold_vertices, 1);
         assert_eq!(r.non_manifold_edges, 0);

@@ -6,14 +6,7 @@ use vstree::tree::{Metric, TreeParams};
 use vstree::{Error, Mesh, Progress};
 
 fn simplify_with(mesh: &Mesh, tree: TreeParams) -> vstree::Result<(Mesh, vstree::SimplifyStats)> {
-    simplify(
-        mesh,
-        &SimplifyParams {
-            tree,
-            ..Default::default()
-        },
-        &mut Progress::none(),
-    )
+    simplify(mesh, &SimplifyParams { tree, ..Default::default() }, &mut Progress::none())
 }
 
 fn simplify_default(mesh: &Mesh) -> vstree::Result<(Mesh, vstree::SimplifyStats)> {
@@ -42,20 +35,14 @@ fn one_two_three_samples_give_trivial_results() {
         assert!(!out.positions.is_empty() && out.positions.len() <= n);
         assert_eq!(stats.tree.samples, n);
     }
-    let triangle = Mesh {
-        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
-        normals: None,
-        triangles: vec![[0, 1, 2]],
-    };
+    let triangle = Mesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y], normals: None, triangles: vec![[0, 1, 2]] };
     let (out, _) = simplify_default(&triangle).unwrap();
     assert!(out.triangles.len() <= 1);
 }
 
 #[test]
 fn coplanar_and_identical_points_work() {
-    let plane: Vec<Vec3> = (0..400)
-        .map(|i| Vec3::new((i % 20) as f32, (i / 20) as f32, 0.0))
-        .collect();
+    let plane: Vec<Vec3> = (0..400).map(|i| Vec3::new((i % 20) as f32, (i / 20) as f32, 0.0)).collect();
     let (out, stats) = simplify_default(&cloud(&plane)).unwrap();
     assert_eq!(stats.tree.leaves, 1, "a plane is one cluster");
     assert_eq!(out.positions.len(), 1);
@@ -65,11 +52,7 @@ fn coplanar_and_identical_points_work() {
     // Identical points with disagreeing normals cannot be split apart: the depth and cell-size
     // guards stop the recursion.
     let mut spiky = same.clone();
-    spiky.normals = Some(
-        (0..50)
-            .map(|i| if i % 2 == 0 { Vec3::Z } else { Vec3::X })
-            .collect(),
-    );
+    spiky.normals = Some((0..50).map(|i| if i % 2 == 0 { Vec3::Z } else { Vec3::X }).collect());
     let (out, _) = simplify_default(&spiky).unwrap();
     assert_eq!(out.positions.len(), 1);
 }
@@ -96,11 +79,7 @@ fn zero_normals_in_a_cloud_are_refused() {
 
 #[test]
 fn out_of_range_indices_are_refused() {
-    let mesh = Mesh {
-        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
-        normals: None,
-        triangles: vec![[0, 1, 7]],
-    };
+    let mesh = Mesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y], normals: None, triangles: vec![[0, 1, 7]] };
     let m = message(simplify_default(&mesh));
     assert!(m.contains("triangle 0") && m.contains('7'), "{m}");
 }
@@ -113,11 +92,8 @@ fn degenerate_triangles_are_ignored() {
         triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
     };
     simplify_default(&mesh).unwrap();
-    let all_degenerate = Mesh {
-        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
-        normals: None,
-        triangles: vec![[0, 0, 1]],
-    };
+    let all_degenerate =
+        Mesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y], normals: None, triangles: vec![[0, 0, 1]] };
     assert!(message(simplify_default(&all_degenerate)).contains("degenerate"));
 }
 
@@ -125,77 +101,16 @@ fn degenerate_triangles_are_ignored() {
 fn absurd_parameters_are_refused_by_name() {
     let mesh = cloud(&[Vec3::ZERO, Vec3::X]);
     let cases: Vec<(TreeParams, &str)> = vec![
-        (
-            TreeParams {
-                error: 0.0,
-                ..Default::default()
-            },
-            "error",
-        ),
-        (
-            TreeParams {
-                error: -1.0,
-                ..Default::default()
-            },
-            "error",
-        ),
-        (
-            TreeParams {
-                error: f64::NAN,
-                ..Default::default()
-            },
-            "error",
-        ),
-        (
-            TreeParams {
-                error: f64::INFINITY,
-                ..Default::default()
-            },
-            "error",
-        ),
-        (
-            TreeParams {
-                metric: Metric::Density,
-                error: 0.5,
-                ..Default::default()
-            },
-            "error",
-        ),
-        (
-            TreeParams {
-                d_a: 1.5,
-                ..Default::default()
-            },
-            "d_a",
-        ),
-        (
-            TreeParams {
-                d_d: f32::NAN,
-                ..Default::default()
-            },
-            "d_d",
-        ),
-        (
-            TreeParams {
-                max_depth: 0,
-                ..Default::default()
-            },
-            "max_depth",
-        ),
-        (
-            TreeParams {
-                max_depth: 99,
-                ..Default::default()
-            },
-            "max_depth",
-        ),
-        (
-            TreeParams {
-                min_cell_size: -1.0,
-                ..Default::default()
-            },
-            "min_cell_size",
-        ),
+        (TreeParams { error: 0.0, ..Default::default() }, "error"),
+        (TreeParams { error: -1.0, ..Default::default() }, "error"),
+        (TreeParams { error: f64::NAN, ..Default::default() }, "error"),
+        (TreeParams { error: f64::INFINITY, ..Default::default() }, "error"),
+        (TreeParams { metric: Metric::Density, error: 0.5, ..Default::default() }, "error"),
+        (TreeParams { d_a: 1.5, ..Default::default() }, "d_a"),
+        (TreeParams { d_d: f32::NAN, ..Default::default() }, "d_d"),
+        (TreeParams { max_depth: 0, ..Default::default() }, "max_depth"),
+        (TreeParams { max_depth: 99, ..Default::default() }, "max_depth"),
+        (TreeParams { min_cell_size: -1.0, ..Default::default() }, "min_cell_size"),
     ];
     for (params, name) in cases {
         match simplify_with(&mesh, params) {
@@ -203,10 +118,7 @@ fn absurd_parameters_are_refused_by_name() {
             other => panic!("{params:?}: expected an error naming {name}, got {other:?}"),
         }
     }
-    let absurd_threads = SimplifyParams {
-        threads: 1 << 20,
-        ..Default::default()
-    };
+    let absurd_threads = SimplifyParams { threads: 1 << 20, ..Default::default() };
     assert!(simplify(&mesh, &absurd_threads, &mut Progress::none()).is_err());
 }
 
@@ -214,10 +126,6 @@ fn absurd_parameters_are_refused_by_name() {
 fn cancelling_stops_with_cancelled() {
     let mesh = vstree::shapes::icosphere(1.0, 5);
     let mut stop = |_: f32, _: &str| false;
-    let result = simplify(
-        &mesh,
-        &SimplifyParams::default(),
-        &mut Progress::new(&mut stop),
-    );
+    let result = simplify(&mesh, &SimplifyParams::default(), &mut Progress::new(&mut stop));
     assert!(matches!(result, Err(Error::Cancelled)));
 }

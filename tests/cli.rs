@@ -11,10 +11,7 @@ fn temp_dir(name: &str) -> PathBuf {
 }
 
 fn vstree(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_vstree"))
-        .args(args)
-        .output()
-        .unwrap()
+    Command::new(env!("CARGO_BIN_EXE_vstree")).args(args).output().unwrap()
 }
 
 #[test]
@@ -24,19 +21,9 @@ fn simplify_writes_a_smaller_mesh_and_reports_what_it_did() {
     let output = dir.join("torus-simplified.obj");
     let torus = shapes::torus(1.0, 0.3, 128, 64);
     io::write(&input, &torus).unwrap();
-    let run = vstree(&[
-        "simplify",
-        input.to_str().unwrap(),
-        output.to_str().unwrap(),
-        "--error",
-        "1e-4",
-    ]);
+    let run = vstree(&["simplify", input.to_str().unwrap(), output.to_str().unwrap(), "--error", "1e-4"]);
     let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(
-        run.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    assert!(run.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&run.stderr));
     let out = io::read(&output).unwrap();
     assert!(out.triangles.len() < torus.triangles.len() / 4 && !out.triangles.is_empty());
     for needle in [
@@ -73,19 +60,11 @@ fn stats_compares_both_trees() {
     let dir = temp_dir("stats");
     let input = dir.join("sphere.off");
     io::write(&input, &shapes::icosphere(1.0, 5)).unwrap();
-    let run = vstree(&[
-        "stats",
-        input.to_str().unwrap(),
-        "--compare",
-        "--error",
-        "1e-4",
-    ]);
+    let run = vstree(&["stats", input.to_str().unwrap(), "--compare", "--error", "1e-4"]);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}");
     assert!(
-        stdout.contains("VsTree: built")
-            && stdout.contains("Octree: built")
-            && stdout.contains("clusters:"),
+        stdout.contains("VsTree: built") && stdout.contains("Octree: built") && stdout.contains("clusters:"),
         "{stdout}"
     );
     std::fs::remove_dir_all(dir).unwrap();
@@ -97,32 +76,18 @@ fn errors_name_the_problem_and_leave_no_output() {
     let input = dir.join("broken.off");
     std::fs::write(&input, "OFF\n3 1 0\n0 0 0\n1 0 0\n").unwrap();
     let output = dir.join("out.ply");
-    let run = vstree(&[
-        "simplify",
-        input.to_str().unwrap(),
-        output.to_str().unwrap(),
-    ]);
+    let run = vstree(&["simplify", input.to_str().unwrap(), output.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(!run.status.success());
     assert!(stderr.contains("broken.off"), "{stderr}");
     assert!(!output.exists());
 
     io::write(&input, &shapes::icosphere(1.0, 2)).unwrap();
-    let run = vstree(&[
-        "simplify",
-        input.to_str().unwrap(),
-        output.to_str().unwrap(),
-        "--error",
-        "-1",
-    ]);
+    let run = vstree(&["simplify", input.to_str().unwrap(), output.to_str().unwrap(), "--error", "-1"]);
     assert!(!run.status.success());
     assert!(String::from_utf8_lossy(&run.stderr).contains("parameter `error`"));
     assert!(!output.exists());
-    let run = vstree(&[
-        "simplify",
-        input.to_str().unwrap(),
-        dir.join("out.stl").to_str().unwrap(),
-    ]);
+    let run = vstree(&["simplify", input.to_str().unwrap(), dir.join("out.stl").to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&run.stderr).contains("unsupported"));
     std::fs::remove_dir_all(dir).unwrap();
 }
@@ -131,20 +96,8 @@ fn errors_name_the_problem_and_leave_no_output() {
 fn help_explains_every_parameter() {
     let run = vstree(&["simplify", "--help"]);
     let help = String::from_utf8_lossy(&run.stdout);
-    for flag in [
-        "--tree",
-        "--metric",
-        "--error",
-        "--da",
-        "--dd",
-        "--threads",
-        "--sampling",
-        "--max-depth",
-    ] {
+    for flag in ["--tree", "--metric", "--error", "--da", "--dd", "--threads", "--sampling", "--max-depth"] {
         assert!(help.contains(flag), "--help lacks {flag}");
     }
-    assert!(
-        help.contains("sqrt(error)"),
-        "the error bound is not explained"
-    );
+    assert!(help.contains("sqrt(error)"), "the error bound is not explained");
 }

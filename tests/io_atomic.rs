@@ -17,10 +17,8 @@ impl Scratch {
     }
 
     fn names(&self) -> Vec<String> {
-        let mut names: Vec<String> = fs::read_dir(&self.0)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
+        let mut names: Vec<String> =
+            fs::read_dir(&self.0).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
         names.sort();
         names
     }
@@ -33,9 +31,7 @@ impl Drop for Scratch {
 }
 
 fn grid(n: u32) -> Mesh {
-    let positions = (0..n * n)
-        .map(|i| Vec3::new((i % n) as f32, (i / n) as f32, 0.0))
-        .collect();
+    let positions = (0..n * n).map(|i| Vec3::new((i % n) as f32, (i / n) as f32, 0.0)).collect();
     let mut triangles = Vec::new();
     for y in 0..n - 1 {
         for x in 0..n - 1 {
@@ -44,11 +40,7 @@ fn grid(n: u32) -> Mesh {
             triangles.push([i + 1, i + n + 1, i + n]);
         }
     }
-    Mesh {
-        positions,
-        normals: None,
-        triangles,
-    }
+    Mesh { positions, normals: None, triangles }
 }
 
 #[test]
@@ -56,10 +48,7 @@ fn missing_directory_is_an_io_error_and_creates_nothing() {
     let scratch = Scratch::new("atomic-missing");
     let target = scratch.0.join("no/such/dir/out.ply");
     let err = io::write(&target, &grid(3)).unwrap_err();
-    assert!(
-        matches!(err, Error::Io { ref path, .. } if path == &target),
-        "{err:?}"
-    );
+    assert!(matches!(err, Error::Io { ref path, .. } if path == &target), "{err:?}");
     assert!(!scratch.0.join("no").exists());
     assert!(scratch.names().is_empty());
 }
@@ -70,10 +59,7 @@ fn successful_writes_leave_only_the_target() {
     for name in ["a.ply", "b.obj", "c.off", "d.xyz", "e.pwn"] {
         io::write(&scratch.0.join(name), &grid(4)).unwrap();
     }
-    assert_eq!(
-        scratch.names(),
-        vec!["a.ply", "b.obj", "c.off", "d.xyz", "e.pwn"]
-    );
+    assert_eq!(scratch.names(), vec!["a.ply", "b.obj", "c.off", "d.xyz", "e.pwn"]);
 }
 
 #[test]
@@ -96,27 +82,15 @@ fn rejected_writes_leave_the_target_untouched() {
     fs::write(&target, "precious").unwrap();
     let mut bad = grid(3);
     bad.triangles.push([0, 1, 99]);
-    assert!(matches!(
-        io::write(&target, &bad),
-        Err(Error::InvalidInput(_))
-    ));
+    assert!(matches!(io::write(&target, &bad), Err(Error::InvalidInput(_))));
     let mut nan = grid(3);
     nan.positions[4].y = f32::NAN;
-    assert!(matches!(
-        io::write(&target, &nan),
-        Err(Error::InvalidInput(_))
-    ));
-    assert!(matches!(
-        io::write(&scratch.0.join("m.stl"), &grid(3)),
-        Err(Error::UnsupportedFormat { .. })
-    ));
+    assert!(matches!(io::write(&target, &nan), Err(Error::InvalidInput(_))));
+    assert!(matches!(io::write(&scratch.0.join("m.stl"), &grid(3)), Err(Error::UnsupportedFormat { .. })));
     // A directory in the way: the rename fails after the temporary file was written.
     fs::create_dir(scratch.0.join("dir.ply")).unwrap();
     fs::write(scratch.0.join("dir.ply/keep"), "x").unwrap();
-    assert!(matches!(
-        io::write(&scratch.0.join("dir.ply"), &grid(3)),
-        Err(Error::Io { .. })
-    ));
+    assert!(matches!(io::write(&scratch.0.join("dir.ply"), &grid(3)), Err(Error::Io { .. })));
     assert_eq!(fs::read_to_string(&target).unwrap(), "precious");
     assert_eq!(scratch.names(), vec!["dir.ply", "m.obj"]);
 }

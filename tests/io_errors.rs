@@ -9,11 +9,7 @@ use vstree::{Error, Mesh, Result};
 /// `(location, message)` of a parse error; fails the test for anything else.
 fn parse_error(result: Result<Mesh>, file: &str) -> (String, String) {
     match result {
-        Err(Error::Parse {
-            path,
-            location,
-            message,
-        }) => {
+        Err(Error::Parse { path, location, message }) => {
             assert_eq!(path, Path::new(file));
             (location, message)
         }
@@ -26,17 +22,11 @@ fn ply(src: &[u8]) -> (String, String) {
 }
 
 fn off(src: &str) -> (String, String) {
-    parse_error(
-        io::off::parse(src.as_bytes(), Path::new("bad.off")),
-        "bad.off",
-    )
+    parse_error(io::off::parse(src.as_bytes(), Path::new("bad.off")), "bad.off")
 }
 
 fn xyz(src: &str) -> (String, String) {
-    parse_error(
-        io::xyz::parse(src.as_bytes(), Path::new("bad.xyz")),
-        "bad.xyz",
-    )
+    parse_error(io::xyz::parse(src.as_bytes(), Path::new("bad.xyz")), "bad.xyz")
 }
 
 const TRIANGLE_HEADER: &str = "ply\nformat binary_little_endian 1.0\nelement vertex 3\n\
@@ -85,18 +75,13 @@ fn bad_magic_and_header_errors_name_the_line() {
     let (location, message) = ply(b"PLY\nformat ascii 1.0\nend_header\n");
     assert_eq!(location, "line 1");
     assert!(message.contains("not a PLY file"), "{message}");
-    let (location, message) =
-        ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n");
+    let (location, message) = ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n");
     assert_eq!(location, "line 4");
-    assert!(
-        message.contains("unknown property type `float128`"),
-        "{message}"
-    );
+    assert!(message.contains("unknown property type `float128`"), "{message}");
     let (location, message) = ply(b"ply\nformat binary_middle_endian 1.0\nend_header\n");
     assert_eq!(location, "line 2");
     assert!(message.contains("unknown format"), "{message}");
-    let (location, message) =
-        ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n");
+    let (location, message) = ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n");
     assert_eq!(location, "line 3");
     assert!(message.contains("`y`"), "{message}");
 }
@@ -105,29 +90,17 @@ fn bad_magic_and_header_errors_name_the_line() {
 fn out_of_range_face_index_names_the_face() {
     let (location, message) = ply(&binary_triangles([[0, 1, 2], [0, 1, 99]], 0.0));
     assert_eq!(location, "face 1");
-    assert!(
-        message.contains("vertex 99") && message.contains("only 3 vertices"),
-        "{message}"
-    );
+    assert!(message.contains("vertex 99") && message.contains("only 3 vertices"), "{message}");
     let (location, message) = ply(&binary_triangles([[0, -1, 2], [0, 1, 2]], 0.0));
     assert_eq!(location, "face 0");
     assert!(message.contains("-1"), "{message}");
     let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"));
     assert_eq!(location, "line 13");
-    assert!(
-        message.contains("face 0") && message.contains("vertex 3"),
-        "{message}"
-    );
+    assert!(message.contains("face 0") && message.contains("vertex 3"), "{message}");
     let (location, message) = off("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 50\n");
     assert_eq!(location, "line 6");
-    assert!(
-        message.contains("face 0") && message.contains("vertex 50"),
-        "{message}"
-    );
-    let obj = io::obj::parse(
-        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
-        Path::new("bad.obj"),
-    );
+    assert!(message.contains("face 0") && message.contains("vertex 50"), "{message}");
+    let obj = io::obj::parse(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", Path::new("bad.obj"));
     parse_error(obj, "bad.obj");
 }
 
@@ -135,25 +108,16 @@ fn out_of_range_face_index_names_the_face() {
 fn two_vertex_face_names_the_face() {
     let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n2 0 1\n"));
     assert_eq!(location, "line 13");
-    assert!(
-        message.contains("face 0") && message.contains("2 vertices"),
-        "{message}"
-    );
+    assert!(message.contains("face 0") && message.contains("2 vertices"), "{message}");
     let (_, message) = off("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n2 0 1\n");
-    assert!(
-        message.contains("face 1") && message.contains("2 vertices"),
-        "{message}"
-    );
+    assert!(message.contains("face 1") && message.contains("2 vertices"), "{message}");
 }
 
 #[test]
 fn non_numeric_tokens_name_the_line() {
     let (location, message) = ply(&ascii_ply("0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n"));
     assert_eq!(location, "line 11");
-    assert!(
-        message.contains("vertex 1") && message.contains("`zero`"),
-        "{message}"
-    );
+    assert!(message.contains("vertex 1") && message.contains("`zero`"), "{message}");
     let (location, message) = off("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 q\n3 0 1 2\n");
     assert_eq!(location, "line 5");
     assert!(message.contains("`q`"), "{message}");
@@ -169,10 +133,7 @@ fn non_numeric_tokens_name_the_line() {
 fn inconsistent_xyz_columns_name_the_line() {
     let (location, message) = xyz("# points\n0 0 0 0 0 1\n1 1 1 0 0 1\n2 2 2\n");
     assert_eq!(location, "line 4");
-    assert!(
-        message.contains("expected 6 numbers like line 2, found 3"),
-        "{message}"
-    );
+    assert!(message.contains("expected 6 numbers like line 2, found 3"), "{message}");
 }
 
 #[test]
@@ -192,20 +153,14 @@ fn absurd_counts_in_tiny_files_fail_fast() {
     assert_eq!(location, "line 13");
     assert!(message.contains("file ends in face 0"), "{message}");
     let (_, message) = off("OFF\n4000000000 4000000000 0\n0 0 0\n");
-    assert!(
-        message.contains("file ends in vertex 1 of 4000000000"),
-        "{message}"
-    );
+    assert!(message.contains("file ends in vertex 1 of 4000000000"), "{message}");
     // Elements without properties occupy no bytes, whatever their count.
     let empty = b"ply\nformat binary_big_endian 1.0\nelement vertex 0\nproperty float x\n\
         property float y\nproperty float z\nelement nothing 1000000000000000000\nend_header\n";
     io::ply::parse(empty, Path::new("bad.ply")).unwrap();
     let too_many = b"ply\nformat ascii 1.0\nelement vertex 5000000000\nproperty float x\n\
         property float y\nproperty float z\nend_header\n";
-    assert!(matches!(
-        io::ply::parse(too_many, Path::new("bad.ply")),
-        Err(Error::TooLarge(_))
-    ));
+    assert!(matches!(io::ply::parse(too_many, Path::new("bad.ply")), Err(Error::TooLarge(_))));
     assert!(start.elapsed() < Duration::from_secs(1));
 }
 
@@ -216,10 +171,7 @@ fn empty_files_are_errors() {
         for bytes in [&b""[..], b"  \n\r\n"] {
             let (location, message) = parse_error(format.parse(bytes, Path::new(name)), name);
             assert_eq!(location, "line 1", "{name}");
-            assert!(
-                message.contains("empty") || message.contains("not a PLY"),
-                "{name}: {message}"
-            );
+            assert!(message.contains("empty") || message.contains("not a PLY"), "{name}: {message}");
         }
     }
 }
@@ -238,10 +190,7 @@ fn nan_coordinates_name_the_vertex() {
     let (location, message) = xyz("0 0 0\nNaN 0 0\n");
     assert_eq!(location, "line 2");
     assert!(message.contains("point 1"), "{message}");
-    let obj = io::obj::parse(
-        b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
-        Path::new("bad.obj"),
-    );
+    let obj = io::obj::parse(b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Path::new("bad.obj"));
     parse_error(obj, "bad.obj");
 }
 
@@ -266,15 +215,9 @@ fn no_input_bytes_make_a_reader_panic() {
     let samples: Vec<(&str, Vec<u8>)> = vec![
         ("t.ply", binary_triangles([[0, 1, 2], [2, 1, 0]], 0.5)),
         ("t.ply", ascii_ply("0 0 0\n1 0 0\n0 1 0\n4 0 1 2 0\n")),
-        (
-            "t.off",
-            b"NOFF 3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2 9 9 9\n".to_vec(),
-        ),
+        ("t.off", b"NOFF 3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2 9 9 9\n".to_vec()),
         ("t.xyz", b"0 0 0 0 0 1\n1 1 1 0 0 1\n".to_vec()),
-        (
-            "t.obj",
-            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n".to_vec(),
-        ),
+        ("t.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n".to_vec()),
     ];
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     for (name, good) in &samples {

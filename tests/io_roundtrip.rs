@@ -38,22 +38,13 @@ fn pyramid(with_normals: bool) -> Mesh {
     Mesh {
         positions,
         normals: with_normals.then_some(normals),
-        triangles: vec![
-            [0, 1, 2],
-            [0, 2, 3],
-            [0, 3, 4],
-            [0, 4, 1],
-            [1, 4, 3],
-            [1, 3, 2],
-        ],
+        triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1], [1, 4, 3], [1, 3, 2]],
     }
 }
 
 fn close(a: &[Vec3], b: &[Vec3]) -> bool {
     a.len() == b.len()
-        && a.iter()
-            .zip(b)
-            .all(|(p, q)| (*p - *q).abs().max_element() <= 1e-5 * (1.0 + p.abs().max_element()))
+        && a.iter().zip(b).all(|(p, q)| (*p - *q).abs().max_element() <= 1e-5 * (1.0 + p.abs().max_element()))
 }
 
 fn assert_close(got: &Mesh, want: &Mesh, what: &str) {
@@ -77,15 +68,9 @@ fn binary_ply_is_exact() {
     let dir = Scratch::new("rt-binary");
     for normals in [false, true] {
         let mesh = pyramid(normals);
-        assert_eq!(
-            cycle(&dir.0, "m.ply", &mesh, &WriteOptions::default()),
-            mesh
-        );
+        assert_eq!(cycle(&dir.0, "m.ply", &mesh, &WriteOptions::default()), mesh);
         let cloud = Mesh::from_points(mesh.positions.clone(), mesh.normals.clone());
-        assert_eq!(
-            cycle(&dir.0, "c.PLY", &cloud, &WriteOptions::default()),
-            cloud
-        );
+        assert_eq!(cycle(&dir.0, "c.PLY", &cloud, &WriteOptions::default()), cloud);
     }
 }
 
@@ -113,11 +98,7 @@ fn point_clouds_are_written_without_faces() {
         assert!(!header.contains("element face"), "{header}");
     }
     for name in ["c.obj", "d.xyz", "e.pwn"] {
-        assert_close(
-            &cycle(&dir.0, name, &cloud, &WriteOptions::default()),
-            &cloud,
-            name,
-        );
+        assert_close(&cycle(&dir.0, name, &cloud, &WriteOptions::default()), &cloud, name);
     }
     let off = cycle(&dir.0, "f.off", &cloud, &WriteOptions::default());
     assert!(off.is_point_cloud() && close(&off.positions, &cloud.positions));
@@ -128,11 +109,7 @@ fn obj_round_trips() {
     let dir = Scratch::new("rt-obj");
     for normals in [false, true] {
         let mesh = pyramid(normals);
-        assert_close(
-            &cycle(&dir.0, "m.obj", &mesh, &WriteOptions::default()),
-            &mesh,
-            "obj",
-        );
+        assert_close(&cycle(&dir.0, "m.obj", &mesh, &WriteOptions::default()), &mesh, "obj");
     }
 }
 
@@ -143,14 +120,7 @@ fn off_round_trips_without_normals() {
         let mesh = pyramid(normals);
         let got = cycle(&dir.0, "m.off", &mesh, &WriteOptions::default());
         // Plain OFF has no normals.
-        assert_close(
-            &got,
-            &Mesh {
-                normals: None,
-                ..mesh
-            },
-            "off",
-        );
+        assert_close(&got, &Mesh { normals: None, ..mesh }, "off");
     }
 }
 
@@ -185,11 +155,7 @@ impl Body {
 /// A PLY with every scalar type, an unknown element with a list, an extra face property,
 /// and a quad, in the given byte order.
 fn hand_built(big: bool) -> Vec<u8> {
-    let format = if big {
-        "binary_big_endian"
-    } else {
-        "binary_little_endian"
-    };
+    let format = if big { "binary_big_endian" } else { "binary_little_endian" };
     let header = format!(
         "ply\nformat {format} 1.0\ncomment hand-built\nobj_info test\n\
          element vertex 4\nproperty float x\nproperty float64 y\nproperty short z\n\
@@ -199,32 +165,15 @@ fn hand_built(big: bool) -> Vec<u8> {
          element face 2\nproperty int flags\nproperty list uint8 uint vertex_index\n\
          end_header\n"
     );
-    let mut body = Body {
-        bytes: header.into_bytes(),
-        big,
-    };
-    let vertices: [(f32, f64, i16); 4] = [
-        (0.5, -1.25, 3),
-        (1.0, 0.0, -2),
-        (-0.25, 2.0, 0),
-        (7.0, 1e-3, 100),
-    ];
+    let mut body = Body { bytes: header.into_bytes(), big };
+    let vertices: [(f32, f64, i16); 4] = [(0.5, -1.25, 3), (1.0, 0.0, -2), (-0.25, 2.0, 0), (7.0, 1e-3, 100)];
     for (k, (x, y, z)) in vertices.into_iter().enumerate() {
-        body.put(x.to_le_bytes())
-            .put(y.to_le_bytes())
-            .put(z.to_le_bytes());
-        body.put([200u8])
-            .put([(-3i8) as u8])
-            .put(60000u16.to_le_bytes());
-        body.put((-70000i32).to_le_bytes())
-            .put(4_000_000_000u32.to_le_bytes());
-        body.put(0.0f64.to_le_bytes())
-            .put(0.0f32.to_le_bytes())
-            .put([k as u8]);
+        body.put(x.to_le_bytes()).put(y.to_le_bytes()).put(z.to_le_bytes());
+        body.put([200u8]).put([(-3i8) as u8]).put(60000u16.to_le_bytes());
+        body.put((-70000i32).to_le_bytes()).put(4_000_000_000u32.to_le_bytes());
+        body.put(0.0f64.to_le_bytes()).put(0.0f32.to_le_bytes()).put([k as u8]);
     }
-    body.put(2u16.to_le_bytes())
-        .put(7i32.to_le_bytes())
-        .put(8i32.to_le_bytes());
+    body.put(2u16.to_le_bytes()).put(7i32.to_le_bytes()).put(8i32.to_le_bytes());
     body.put(0u16.to_le_bytes());
     body.put((-1i32).to_le_bytes()).put([3u8]);
     for i in [0u32, 1, 2] {

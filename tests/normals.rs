@@ -4,9 +4,7 @@
 mod common;
 
 use glam::Vec3;
-use vstree::normals::{
-    ensure_normals, estimate_normals, orient_normals, NormalParams, Orientation,
-};
+use vstree::normals::{ensure_normals, estimate_normals, orient_normals, NormalParams, Orientation};
 use vstree::rng::Rng;
 use vstree::shapes::{add_noise, icosphere, sample_surface, torus};
 use vstree::{Error, Mesh, Progress};
@@ -14,11 +12,7 @@ use vstree::{Error, Mesh, Progress};
 /// Fraction of `normals` within `degrees` of `truth` (signed: pointing the same way).
 fn within(normals: &[Vec3], truth: &[Vec3], degrees: f32) -> f64 {
     let cos = degrees.to_radians().cos();
-    let good = normals
-        .iter()
-        .zip(truth)
-        .filter(|(n, t)| n.normalize().dot(t.normalize()) >= cos)
-        .count();
+    let good = normals.iter().zip(truth).filter(|(n, t)| n.normalize().dot(t.normalize()) >= cos).count();
     good as f64 / normals.len() as f64
 }
 
@@ -45,11 +39,7 @@ fn sphere_normals_are_outward_and_accurate() {
     let normals = estimate(&cloud.positions, &NormalParams::default());
     let truth = sphere_truth(&cloud.positions);
     let (w5, side) = (within(&normals, &truth, 5.0), agreeing(&normals, &truth));
-    println!(
-        "sphere: {:.2}% within 5 degrees, {:.2}% outward",
-        100.0 * w5,
-        100.0 * side
-    );
+    println!("sphere: {:.2}% within 5 degrees, {:.2}% outward", 100.0 * w5, 100.0 * side);
     assert!(w5 >= 0.99 && side == 1.0);
 }
 
@@ -58,18 +48,11 @@ fn torus_normals_are_outward_and_accurate() {
     // Genus 1: the hole's side of the tube must face the hole, not the centroid.
     let (major, minor) = (1.0, 0.35);
     let cloud = sample_surface(&torus(major, minor, 256, 96), 40_000, 2);
-    let truth: Vec<Vec3> = cloud
-        .positions
-        .iter()
-        .map(|p| (*p - Vec3::new(p.x, p.y, 0.0).normalize() * major).normalize())
-        .collect();
+    let truth: Vec<Vec3> =
+        cloud.positions.iter().map(|p| (*p - Vec3::new(p.x, p.y, 0.0).normalize() * major).normalize()).collect();
     let normals = estimate(&cloud.positions, &NormalParams::default());
     let (w5, side) = (within(&normals, &truth, 5.0), agreeing(&normals, &truth));
-    println!(
-        "torus: {:.2}% within 5 degrees, {:.2}% outward",
-        100.0 * w5,
-        100.0 * side
-    );
+    println!("torus: {:.2}% within 5 degrees, {:.2}% outward", 100.0 * w5, 100.0 * side);
     assert!(w5 >= 0.99 && side == 1.0);
 }
 
@@ -81,11 +64,7 @@ fn noisy_sphere_normals_are_outward() {
     let truth = sphere_truth(&cloud.positions);
     let normals = estimate(&cloud.positions, &NormalParams::default());
     let (w15, side) = (within(&normals, &truth, 15.0), agreeing(&normals, &truth));
-    println!(
-        "noisy sphere: {:.2}% within 15 degrees, {:.2}% outward",
-        100.0 * w15,
-        100.0 * side
-    );
+    println!("noisy sphere: {:.2}% within 15 degrees, {:.2}% outward", 100.0 * w15, 100.0 * side);
     assert!(w15 >= 0.97 && side >= 0.999);
 }
 
@@ -94,21 +73,14 @@ fn plane_patch_normals_are_consistent() {
     let mut rng = Rng::new(5);
     let tilt = Vec3::new(0.3, -0.2, 1.0).normalize();
     let (u, v) = tilt.any_orthonormal_pair();
-    let points: Vec<Vec3> = (0..5000)
-        .map(|_| u * rng.f32() * 4.0 + v * rng.f32() * 2.0 + Vec3::new(1.0, 2.0, 3.0))
-        .collect();
+    let points: Vec<Vec3> =
+        (0..5000).map(|_| u * rng.f32() * 4.0 + v * rng.f32() * 2.0 + Vec3::new(1.0, 2.0, 3.0)).collect();
     for orient in [Orientation::Propagate, Orientation::PropagateOutward] {
-        let params = NormalParams {
-            orient,
-            ..Default::default()
-        };
+        let params = NormalParams { orient, ..Default::default() };
         let normals = estimate(&points, &params);
         // No inside to face away from: Hoppe's rule (the normal points up) decides.
         let up = within(&normals, &vec![tilt; points.len()], 1.0);
-        println!(
-            "plane {orient:?}: {:.2}% within 1 degree of the upward normal",
-            100.0 * up
-        );
+        println!("plane {orient:?}: {:.2}% within 1 degree of the upward normal", 100.0 * up);
         assert_eq!(up, 1.0);
     }
 }
@@ -118,44 +90,21 @@ fn propagation_repairs_randomly_flipped_normals() {
     let cloud = sphere_cloud(20_000, 6);
     let truth = cloud.normals.clone().unwrap();
     let mut rng = Rng::new(7);
-    let scrambled: Vec<Vec3> = truth
-        .iter()
-        .map(|&n| if rng.f32() < 0.5 { -n } else { n })
-        .collect();
+    let scrambled: Vec<Vec3> = truth.iter().map(|&n| if rng.f32() < 0.5 { -n } else { n }).collect();
     for orient in [Orientation::Propagate, Orientation::PropagateMajority] {
         let mut normals = scrambled.clone();
-        let params = NormalParams {
-            orient,
-            ..Default::default()
-        };
-        let report = orient_normals(
-            &cloud.positions,
-            &mut normals,
-            &params,
-            &mut Progress::none(),
-        )
-        .unwrap();
+        let params = NormalParams { orient, ..Default::default() };
+        let report = orient_normals(&cloud.positions, &mut normals, &params, &mut Progress::none()).unwrap();
         let side = agreeing(&normals, &truth);
         let consistent = side.max(1.0 - side);
-        println!(
-            "scrambled sphere {orient:?}: {:.2}% consistent, {report:?}",
-            100.0 * consistent
-        );
+        println!("scrambled sphere {orient:?}: {:.2}% consistent, {report:?}", 100.0 * consistent);
         assert!(consistent >= 0.99);
     }
     let mut normals = scrambled.clone();
-    let report = orient_normals(
-        &cloud.positions,
-        &mut normals,
-        &NormalParams::default(),
-        &mut Progress::none(),
-    )
-    .unwrap();
+    let report =
+        orient_normals(&cloud.positions, &mut normals, &NormalParams::default(), &mut Progress::none()).unwrap();
     let side = agreeing(&normals, &truth);
-    println!(
-        "scrambled sphere outward: {:.2}% outward, {report:?}",
-        100.0 * side
-    );
+    println!("scrambled sphere outward: {:.2}% outward, {report:?}", 100.0 * side);
     assert!(side >= 0.99);
     assert_eq!(report.components, 1);
 }
@@ -174,8 +123,7 @@ fn separate_components_are_each_turned_outward() {
     points.extend(ring.positions.iter().map(|p| *p + Vec3::Y * 5.0));
     truth.extend(ring.normals.unwrap());
     let mut cloud = Mesh::from_points(points, None);
-    let report =
-        ensure_normals(&mut cloud, &NormalParams::default(), &mut Progress::none()).unwrap();
+    let report = ensure_normals(&mut cloud, &NormalParams::default(), &mut Progress::none()).unwrap();
     let side = agreeing(cloud.normals.as_ref().unwrap(), &truth);
     println!("three shapes: {:.2}% outward, {report:?}", 100.0 * side);
     assert_eq!(report.orient.unwrap().components, 3);
@@ -187,10 +135,7 @@ fn same_normals_for_one_and_two_threads() {
     let mut cloud = sample_surface(&torus(1.0, 0.3, 128, 48), 30_000, 8);
     add_noise(&mut cloud, 0.003, 0.0, 9);
     let run = |threads| {
-        let params = NormalParams {
-            threads,
-            ..Default::default()
-        };
+        let params = NormalParams { threads, ..Default::default() };
         estimate(&cloud.positions, &params)
     };
     let one = run(1);
@@ -204,22 +149,17 @@ fn ensure_normals_estimates_keeps_and_reorients() {
     let truth = sphere_truth(&cloud.positions);
 
     let mut bare = Mesh::from_points(cloud.positions.clone(), None);
-    let report =
-        ensure_normals(&mut bare, &NormalParams::default(), &mut Progress::none()).unwrap();
+    let report = ensure_normals(&mut bare, &NormalParams::default(), &mut Progress::none()).unwrap();
     assert_eq!(report.estimated, 5_000);
     assert_eq!(agreeing(bare.normals.as_ref().unwrap(), &truth), 1.0);
 
     // Given normals (here inward) are kept, unless re-orientation is asked for.
     let inward: Vec<Vec3> = truth.iter().map(|n| -*n).collect();
     let mut given = Mesh::from_points(cloud.positions.clone(), Some(inward.clone()));
-    let report =
-        ensure_normals(&mut given, &NormalParams::default(), &mut Progress::none()).unwrap();
+    let report = ensure_normals(&mut given, &NormalParams::default(), &mut Progress::none()).unwrap();
     assert_eq!(report.estimated, 0);
     assert_eq!(given.normals.as_ref().unwrap(), &inward);
-    let params = NormalParams {
-        reorient_given: true,
-        ..Default::default()
-    };
+    let params = NormalParams { reorient_given: true, ..Default::default() };
     let report = ensure_normals(&mut given, &params, &mut Progress::none()).unwrap();
     assert_eq!(report.orient.unwrap().flipped, 5_000);
     assert_eq!(agreeing(given.normals.as_ref().unwrap(), &truth), 1.0);
@@ -230,12 +170,7 @@ fn ensure_normals_estimates_keeps_and_reorients() {
         *n = Vec3::ZERO;
     }
     let mut partial = Mesh::from_points(cloud.positions.clone(), Some(holes));
-    let report = ensure_normals(
-        &mut partial,
-        &NormalParams::default(),
-        &mut Progress::none(),
-    )
-    .unwrap();
+    let report = ensure_normals(&mut partial, &NormalParams::default(), &mut Progress::none()).unwrap();
     assert_eq!(report.estimated, 5_000usize.div_ceil(7));
     assert!(within(partial.normals.as_ref().unwrap(), &inward, 10.0) >= 0.99);
 }
@@ -261,52 +196,28 @@ fn bad_inputs_give_clear_errors() {
     nan[42].y = f32::NEG_INFINITY;
     assert!(run(&nan).unwrap_err().to_string().contains("point 42"));
     for neighbours in [0, 2, 257] {
-        let params = NormalParams {
-            neighbours,
-            ..Default::default()
-        };
+        let params = NormalParams { neighbours, ..Default::default() };
         let err = estimate_normals(&line, &params, &mut Progress::none()).unwrap_err();
-        assert!(matches!(
-            err,
-            Error::InvalidParameter {
-                name: "neighbours",
-                ..
-            }
-        ));
+        assert!(matches!(err, Error::InvalidParameter { name: "neighbours", .. }));
     }
     let points = sphere_cloud(100, 12).positions;
     let mut short = vec![Vec3::Z; 99];
     let err = orient_normals(&points, &mut short, &params, &mut Progress::none()).unwrap_err();
-    assert!(
-        err.to_string().contains("99 normals for 100 points"),
-        "{err}"
-    );
+    assert!(err.to_string().contains("99 normals for 100 points"), "{err}");
 }
 
 #[test]
 fn tiny_flat_and_duplicated_clouds_work() {
     let params = NormalParams::default();
     // 3 and 5 points: fewer than neighbours + 1, so every point uses all the others.
-    for points in [
-        vec![Vec3::ZERO, Vec3::X, Vec3::Y],
-        vec![
-            Vec3::ZERO,
-            Vec3::X,
-            Vec3::Y,
-            Vec3::ONE.with_z(0.0),
-            Vec3::X * 3.0,
-        ],
-    ] {
+    for points in
+        [vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ONE.with_z(0.0), Vec3::X * 3.0]]
+    {
         let normals = estimate(&points, &params);
-        assert!(
-            normals.iter().all(|n| n.abs_diff_eq(Vec3::Z, 1e-6)),
-            "{normals:?}"
-        );
+        assert!(normals.iter().all(|n| n.abs_diff_eq(Vec3::Z, 1e-6)), "{normals:?}");
     }
     // A grid on a plane (exact ties everywhere), with every point three times.
-    let grid: Vec<Vec3> = (0..900)
-        .flat_map(|i| [Vec3::new((i % 30) as f32, 0.0, (i / 30) as f32); 3])
-        .collect();
+    let grid: Vec<Vec3> = (0..900).flat_map(|i| [Vec3::new((i % 30) as f32, 0.0, (i / 30) as f32); 3]).collect();
     let normals = estimate(&grid, &params);
     let up = within(&normals, &vec![Vec3::Y; grid.len()], 0.01);
     let down = within(&normals, &vec![-Vec3::Y; grid.len()], 0.01);
@@ -334,20 +245,11 @@ fn progress_is_reported_and_cancellation_stops() {
         fractions.push(f);
         true
     };
-    estimate_normals(
-        &points,
-        &NormalParams::default(),
-        &mut Progress::new(&mut record),
-    )
-    .unwrap();
+    estimate_normals(&points, &NormalParams::default(), &mut Progress::new(&mut record)).unwrap();
     assert!(fractions.windows(2).all(|w| w[0] <= w[1]), "{fractions:?}");
     assert_eq!(fractions.last(), Some(&1.0));
     let mut stop = |f: f32, _: &str| f < 0.5;
-    let err = estimate_normals(
-        &points,
-        &NormalParams::default(),
-        &mut Progress::new(&mut stop),
-    );
+    let err = estimate_normals(&points, &NormalParams::default(), &mut Progress::new(&mut stop));
     assert!(matches!(err, Err(Error::Cancelled)));
 }
 
@@ -360,10 +262,7 @@ fn locally_consistent(points: &[Vec3], normals: &[Vec3]) -> f64 {
     let good = (0..points.len())
         .filter(|&i| {
             let row = &rows[i * k..][..k];
-            let agree = row
-                .iter()
-                .filter(|&&j| normals[i].dot(normals[j as usize]) > 0.0)
-                .count();
+            let agree = row.iter().filter(|&&j| normals[i].dot(normals[j as usize]) > 0.0).count();
             2 * agree > k
         })
         .count();
@@ -377,19 +276,11 @@ fn armadillo_inward_normals_are_turned_outward() {
     };
     let given = cloud.normals.clone().unwrap();
     let mut normals = given.clone();
-    let report = orient_normals(
-        &cloud.positions,
-        &mut normals,
-        &NormalParams::default(),
-        &mut Progress::none(),
-    )
-    .unwrap();
+    let report =
+        orient_normals(&cloud.positions, &mut normals, &NormalParams::default(), &mut Progress::none()).unwrap();
     let opposite: Vec<Vec3> = given.iter().map(|n| -*n).collect();
     let flipped = agreeing(&normals, &opposite);
-    println!(
-        "armadillo: {:.2}% of the given (inward) normals flipped, {report:?}",
-        100.0 * flipped
-    );
+    println!("armadillo: {:.2}% of the given (inward) normals flipped, {report:?}", 100.0 * flipped);
     assert!(flipped >= 0.99);
 }
 
@@ -400,15 +291,10 @@ fn kitten_estimated_normals_match_the_files() {
     };
     let given = cloud.normals.clone().unwrap();
     let mut bare = Mesh::from_points(cloud.positions.clone(), None);
-    let report =
-        ensure_normals(&mut bare, &NormalParams::default(), &mut Progress::none()).unwrap();
+    let report = ensure_normals(&mut bare, &NormalParams::default(), &mut Progress::none()).unwrap();
     let normals = bare.normals.unwrap();
     let (w30, side) = (within(&normals, &given, 30.0), agreeing(&normals, &given));
-    println!(
-        "kitten: {:.2}% within 30 degrees, {:.2}% on the file's side, {report:?}",
-        100.0 * w30,
-        100.0 * side
-    );
+    println!("kitten: {:.2}% within 30 degrees, {:.2}% on the file's side, {report:?}", 100.0 * w30, 100.0 * side);
     assert!(w30 >= 0.97 && side >= 0.99);
 }
 
@@ -420,13 +306,8 @@ fn lion_normals_become_consistent() {
     let given = cloud.normals.clone().unwrap();
     let before = locally_consistent(&cloud.positions, &given);
     let mut normals = given.clone();
-    let report = orient_normals(
-        &cloud.positions,
-        &mut normals,
-        &NormalParams::default(),
-        &mut Progress::none(),
-    )
-    .unwrap();
+    let report =
+        orient_normals(&cloud.positions, &mut normals, &NormalParams::default(), &mut Progress::none()).unwrap();
     let after = locally_consistent(&cloud.positions, &normals);
     let kept = agreeing(&normals, &given);
     println!(
@@ -447,17 +328,12 @@ fn bunny_range_scan_faces_the_scanner() {
     };
     assert!(cloud.normals.is_none());
     let mut cloud = cloud;
-    let report =
-        ensure_normals(&mut cloud, &NormalParams::default(), &mut Progress::none()).unwrap();
+    let report = ensure_normals(&mut cloud, &NormalParams::default(), &mut Progress::none()).unwrap();
     let normals = cloud.normals.unwrap();
     // The scanner looks down -z at the scan (its first view defines the bunny's frame).
     let facing = normals.iter().filter(|n| n.z > 0.0).count() as f64 / normals.len() as f64;
     let consistent = locally_consistent(&cloud.positions, &normals);
-    println!(
-        "bun000: {:.2}% facing +z, {:.2}% locally consistent, {report:?}",
-        100.0 * facing,
-        100.0 * consistent
-    );
+    println!("bun000: {:.2}% facing +z, {:.2}% locally consistent, {report:?}", 100.0 * facing, 100.0 * consistent);
     assert!(facing >= 0.95 && consistent >= 0.99);
 }
 
@@ -469,19 +345,11 @@ fn oni_sparse_given_normals_survive_reorientation() {
     // 1,435 points with thin features (horns, lips): neighbours often lie across a gap.
     let given = cloud.normals.clone().unwrap();
     let mut normals = given.clone();
-    let report = orient_normals(
-        &cloud.positions,
-        &mut normals,
-        &NormalParams::default(),
-        &mut Progress::none(),
-    )
-    .unwrap();
+    let report =
+        orient_normals(&cloud.positions, &mut normals, &NormalParams::default(), &mut Progress::none()).unwrap();
     let kept = agreeing(&normals, &given);
     let estimated = estimate(&cloud.positions, &NormalParams::default());
-    let (side, w30) = (
-        agreeing(&estimated, &given),
-        within(&estimated, &given, 30.0),
-    );
+    let (side, w30) = (agreeing(&estimated, &given), within(&estimated, &given, 30.0));
     println!(
         "oni: re-oriented {:.2}% kept their sign, {report:?}; estimated: {:.2}% on the file's \
          side, {:.2}% within 30 degrees",
@@ -502,11 +370,7 @@ fn ball_estimated_normals_match_the_files() {
     let given = cloud.normals.clone().unwrap();
     let normals = estimate(&cloud.positions, &NormalParams::default());
     let (side, w30) = (agreeing(&normals, &given), within(&normals, &given, 30.0));
-    println!(
-        "ball: {:.2}% on the file's side, {:.2}% within 30 degrees",
-        100.0 * side,
-        100.0 * w30
-    );
+    println!("ball: {:.2}% on the file's side, {:.2}% within 30 degrees", 100.0 * side, 100.0 * w30);
     assert!(side >= 0.99 && w30 >= 0.97);
 }
 
@@ -519,11 +383,7 @@ fn cube_estimated_normals_face_outward_on_its_hull() {
     // +x/+y/+z side (half of them inward), so only their directions are compared.
     let given = cloud.normals.clone().unwrap();
     let normals = estimate(&cloud.positions, &NormalParams::default());
-    let unsigned: Vec<Vec3> = normals
-        .iter()
-        .zip(&given)
-        .map(|(n, g)| if n.dot(*g) < 0.0 { -*n } else { *n })
-        .collect();
+    let unsigned: Vec<Vec3> = normals.iter().zip(&given).map(|(n, g)| if n.dot(*g) < 0.0 { -*n } else { *n }).collect();
     let w30 = within(&unsigned, &given, 30.0);
     // The points on the six planes of the bounding box must face out of it.
     let bounds = cloud.bounds().unwrap();
@@ -550,23 +410,15 @@ fn cube_estimated_normals_face_outward_on_its_hull() {
 
 #[test]
 fn merged_bunny_scans_match_the_reconstructed_mesh() {
-    let (Some(scans), Some(mesh)) = (
-        common::load("bunny_scans_merged.ply"),
-        common::load("bunny_zipper.ply"),
-    ) else {
+    let (Some(scans), Some(mesh)) = (common::load("bunny_scans_merged.ply"), common::load("bunny_zipper.ply")) else {
         return;
     };
     // Truth: the normal of the nearest vertex of the mesh reconstructed from these scans.
     let samples = vstree::SampleSet::from_mesh(&mesh, vstree::MeshSampling::Vertices).unwrap();
     let tree = vstree::knn::KdTree::new(&samples.positions).unwrap();
-    let truth: Vec<Vec3> = scans
-        .positions
-        .iter()
-        .map(|p| samples.normals[tree.knn(*p, 1)[0].index as usize])
-        .collect();
+    let truth: Vec<Vec3> = scans.positions.iter().map(|p| samples.normals[tree.knn(*p, 1)[0].index as usize]).collect();
     let mut cloud = Mesh::from_points(scans.positions.clone(), None);
-    let report =
-        ensure_normals(&mut cloud, &NormalParams::default(), &mut Progress::none()).unwrap();
+    let report = ensure_normals(&mut cloud, &NormalParams::default(), &mut Progress::none()).unwrap();
     let normals = cloud.normals.unwrap();
     let (side, w20) = (agreeing(&normals, &truth), within(&normals, &truth, 20.0));
     println!(

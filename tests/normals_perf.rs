@@ -52,19 +52,11 @@ fn normals_timing_1m_5m() {
                 }
                 true
             };
-            let params = NormalParams {
-                threads,
-                ..Default::default()
-            };
+            let params = NormalParams { threads, ..Default::default() };
             let t0 = Instant::now();
-            let normals =
-                estimate_normals(&points, &params, &mut Progress::new(&mut record)).unwrap();
+            let normals = estimate_normals(&points, &params, &mut Progress::new(&mut record)).unwrap();
             let total = t0.elapsed().as_secs_f64();
-            let outward = points
-                .iter()
-                .zip(&normals)
-                .filter(|(p, n)| p.dot(**n) > 0.0)
-                .count();
+            let outward = points.iter().zip(&normals).filter(|(p, n)| p.dot(**n) > 0.0).count();
             println!(
                 "normals n={n} k={} threads={threads}: {total:.3} s, {:.3}% outward",
                 params.neighbours,

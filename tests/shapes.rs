@@ -2,12 +2,10 @@
 
 use glam::Vec3;
 use std::path::Path;
-use vstree::distance::{
-    chamfer_and_hausdorff, one_sided, point_to_mesh_distances, Target, TriangleBvh,
-};
+use vstree::distance::{chamfer_and_hausdorff, one_sided, point_to_mesh_distances, Target, TriangleBvh};
 use vstree::shapes::{
-    add_noise, bumpy_radius, bumpy_sphere, double_torus, genus_n_pretzel, icosphere, implicit_mesh,
-    sample_surface, torus,
+    add_noise, bumpy_radius, bumpy_sphere, double_torus, genus_n_pretzel, icosphere, implicit_mesh, sample_surface,
+    torus,
 };
 use vstree::topology::{analyze, signed_volume, surface_area, valence_histogram, valences};
 use vstree::Mesh;
@@ -20,34 +18,18 @@ fn assert_closed_surface(name: &str, mesh: &Mesh, genus: u32) {
     assert_eq!(report.genus(), Some(genus), "{name}: {report:?}");
     assert_eq!(report.components, 1, "{name}");
     assert_eq!(report.unreferenced_vertices, 0, "{name}");
-    assert_eq!(
-        report.euler_characteristic,
-        2 - 2 * i64::from(genus),
-        "{name}"
-    );
-    assert!(
-        signed_volume(mesh) > 0.0,
-        "{name}: volume {}",
-        signed_volume(mesh)
-    );
+    assert_eq!(report.euler_characteristic, 2 - 2 * i64::from(genus), "{name}");
+    assert!(signed_volume(mesh) > 0.0, "{name}: volume {}", signed_volume(mesh));
     let normals = mesh.normals.as_ref().expect("normals");
     assert_eq!(normals.len(), mesh.positions.len(), "{name}");
-    assert!(
-        normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4),
-        "{name}: normals not unit"
-    );
+    assert!(normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4), "{name}: normals not unit");
     mesh.check().unwrap();
 }
 
 /// Fraction of vertex normals that point away from the inside along `outward(p)`.
 fn fraction_outward(mesh: &Mesh, outward: impl Fn(Vec3) -> Vec3) -> f32 {
     let normals = mesh.normals.as_ref().unwrap();
-    let good = mesh
-        .positions
-        .iter()
-        .zip(normals)
-        .filter(|(p, n)| n.dot(outward(**p)) > 0.0)
-        .count();
+    let good = mesh.positions.iter().zip(normals).filter(|(p, n)| n.dot(outward(**p)) > 0.0).count();
     good as f32 / mesh.positions.len() as f32
 }
 
@@ -59,11 +41,7 @@ fn icosphere_figures() {
     assert_closed_surface("icosphere", &m, 0);
     assert_eq!(analyze(&m).euler_characteristic, 2);
     for p in &m.positions {
-        assert!(
-            (p.length() - 1.0).abs() <= 1e-6,
-            "{p} has radius {}",
-            p.length()
-        );
+        assert!((p.length() - 1.0).abs() <= 1e-6, "{p} has radius {}", p.length());
     }
     // Twelve valence-5 vertices, the rest valence 6.
     assert_eq!(valence_histogram(&m), {
@@ -81,10 +59,7 @@ fn icosphere_figures() {
 #[test]
 fn torus_figures() {
     let m = torus(2.0, 0.5, 48, 16);
-    assert_eq!(
-        (m.positions.len(), m.triangles.len()),
-        (48 * 16, 2 * 48 * 16)
-    );
+    assert_eq!((m.positions.len(), m.triangles.len()), (48 * 16, 2 * 48 * 16));
     assert_closed_surface("torus", &m, 1);
     let exact = 2.0 * std::f64::consts::PI.powi(2) * 2.0 * 0.25;
     let volume = signed_volume(&m);
@@ -130,21 +105,14 @@ fn bumpy_sphere_lies_on_its_surface() {
         assert!((p.length() - r).abs() < 1e-5);
     }
     let lengths: Vec<f32> = m.positions.iter().map(|p| p.length()).collect();
-    let (lo, hi) = lengths
-        .iter()
-        .fold((f32::MAX, 0.0f32), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+    let (lo, hi) = lengths.iter().fold((f32::MAX, 0.0f32), |(lo, hi), &r| (lo.min(r), hi.max(r)));
     assert!(hi - lo > 0.25 * radius, "bumps too small: {lo}..{hi}");
     assert!(fraction_outward(&m, |p| p) > 0.95);
 }
 
 #[test]
 fn implicit_mesh_normals_follow_the_gradient() {
-    let m = implicit_mesh(
-        |p| (p / Vec3::new(1.0, 0.6, 0.4)).length() - 1.0,
-        Vec3::splat(-1.2),
-        Vec3::splat(1.2),
-        40,
-    );
+    let m = implicit_mesh(|p| (p / Vec3::new(1.0, 0.6, 0.4)).length() - 1.0, Vec3::splat(-1.2), Vec3::splat(1.2), 40);
     assert_closed_surface("ellipsoid", &m, 0);
     let exact = 4.0 / 3.0 * std::f64::consts::PI * 0.24;
     assert!((signed_volume(&m) - exact).abs() < 0.02 * exact);
@@ -158,13 +126,8 @@ fn implicit_mesh_normals_follow_the_gradient() {
 
 #[test]
 fn implicit_mesh_is_deterministic_across_thread_counts() {
-    let run = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(genus_n_pretzel_small)
-    };
+    let run =
+        |threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(genus_n_pretzel_small);
     assert_eq!(run(1), run(2));
 }
 
@@ -187,11 +150,7 @@ fn sampling_a_sphere() {
     let normals = cloud.normals.as_ref().unwrap();
     assert_eq!(normals.len(), count);
     for (p, n) in cloud.positions.iter().zip(normals) {
-        assert!(
-            (p.length() - 1.0).abs() < 1e-3,
-            "{p} at radius {}",
-            p.length()
-        );
+        assert!((p.length() - 1.0).abs() < 1e-3, "{p} at radius {}", p.length());
         assert!(n.dot(p.normalize()) > 0.999);
     }
     // Uniform by area: each octant holds about an eighth of the points.
@@ -205,14 +164,8 @@ fn sampling_a_sphere() {
         assert!((n as f32 - expected).abs() < 0.03 * expected, "{octants:?}");
     }
     // Seeds matter; a mesh without area gives nothing.
-    assert_ne!(
-        sample_surface(&sphere, 10, 8).positions,
-        cloud.positions[..10]
-    );
-    assert_eq!(
-        sample_surface(&sphere, 10, 7).positions,
-        cloud.positions[..10]
-    );
+    assert_ne!(sample_surface(&sphere, 10, 8).positions, cloud.positions[..10]);
+    assert_eq!(sample_surface(&sphere, 10, 7).positions, cloud.positions[..10]);
     assert!(sample_surface(&Mesh::default(), 10, 1).positions.is_empty());
     let flat = Mesh {
         positions: vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
@@ -247,15 +200,11 @@ fn sampling_is_uniform_across_triangles_of_different_size() {
 fn sampling_and_noise_are_deterministic_across_thread_counts() {
     let mesh = torus(1.0, 0.3, 64, 24);
     let run = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| {
-                let mut cloud = sample_surface(&mesh, 200_001, 42);
-                add_noise(&mut cloud, 0.01, 0.1, 43);
-                cloud
-            })
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
+            let mut cloud = sample_surface(&mesh, 200_001, 42);
+            add_noise(&mut cloud, 0.01, 0.1, 43);
+            cloud
+        })
     };
     let (one, two) = (run(1), run(2));
     assert_eq!(one, two);
@@ -342,10 +291,8 @@ fn topology_detects_defects() {
     // Two spheres: two components, each genus 0.
     let mut two = base.clone();
     let shift = base.positions.len() as u32;
-    two.positions
-        .extend(base.positions.iter().map(|p| *p + Vec3::X * 5.0));
-    two.triangles
-        .extend(base.triangles.iter().map(|t| t.map(|v| v + shift)));
+    two.positions.extend(base.positions.iter().map(|p| *p + Vec3::X * 5.0));
+    two.triangles.extend(base.triangles.iter().map(|t| t.map(|v| v + shift)));
     two.normals = None;
     let r = analyze(&two);
     assert_eq!((r.components, r.genus()), (2, Some(0)));
@@ -355,9 +302,7 @@ fn topology_detects_defects() {
     let mut mixed = torus(1.0, 0.3, 24, 12);
     let shift = mixed.positions.len() as u32;
     mixed.positions.extend(&base.positions);
-    mixed
-        .triangles
-        .extend(base.triangles.iter().map(|t| t.map(|v| v + shift)));
+    mixed.triangles.extend(base.triangles.iter().map(|t| t.map(|v| v + shift)));
     assert_eq!(analyze(&mixed).genus(), Some(1));
 
     let area = surface_area(&icosphere(1.0, 6));
@@ -368,17 +313,12 @@ fn topology_detects_defects() {
 /// project's own reader lives on another branch).
 fn read_off(path: &Path) -> Mesh {
     let text = std::fs::read_to_string(path).unwrap();
-    let mut tokens = text
-        .lines()
-        .map(|l| l.split('#').next().unwrap_or(""))
-        .flat_map(str::split_whitespace);
+    let mut tokens = text.lines().map(|l| l.split('#').next().unwrap_or("")).flat_map(str::split_whitespace);
     assert_eq!(tokens.next(), Some("OFF"));
     let mut number = || tokens.next().unwrap().parse::<f64>().unwrap();
     let (nv, nf) = (number() as usize, number() as usize);
     number();
-    let positions = (0..nv)
-        .map(|_| Vec3::new(number() as f32, number() as f32, number() as f32))
-        .collect();
+    let positions = (0..nv).map(|_| Vec3::new(number() as f32, number() as f32, number() as f32)).collect();
     let mut triangles = Vec::new();
     for _ in 0..nf {
         let k = number() as usize;
@@ -387,11 +327,7 @@ fn read_off(path: &Path) -> Mesh {
             triangles.push([ids[0], ids[i], ids[i + 1]]);
         }
     }
-    Mesh {
-        positions,
-        normals: None,
-        triangles,
-    }
+    Mesh { positions, normals: None, triangles }
 }
 
 #[test]
@@ -401,12 +337,7 @@ fn real_meshes_have_their_documented_genus() {
         eprintln!("skipping: {} is absent", data.display());
         return;
     }
-    for (file, genus) in [
-        ("3holes.off", 3),
-        ("fertility_20k.off", 4),
-        ("eight.off", 2),
-        ("knot1.off", 1),
-    ] {
+    for (file, genus) in [("3holes.off", 3), ("fertility_20k.off", 4), ("eight.off", 2), ("knot1.off", 1)] {
         let path = data.join(file);
         if !path.is_file() {
             eprintln!("skipping: {} is absent", path.display());

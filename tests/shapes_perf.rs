@@ -23,46 +23,27 @@ fn timings() {
     let mesh = torus(1.0, 0.3, 500, 100);
     assert_eq!(mesh.triangles.len(), 100_000);
 
-    let cloud = timed("sample_surface 5M points (100k triangles)", || {
-        sample_surface(&mesh, 5_000_000, 1)
-    });
+    let cloud = timed("sample_surface 5M points (100k triangles)", || sample_surface(&mesh, 5_000_000, 1));
     assert_eq!(cloud.positions.len(), 5_000_000);
-    let mut noisy = timed("sample_surface 1M points", || {
-        sample_surface(&mesh, 1_000_000, 2)
-    });
-    timed("add_noise 1M points", || {
-        add_noise(&mut noisy, 0.005, 0.05, 3)
-    });
+    let mut noisy = timed("sample_surface 1M points", || sample_surface(&mesh, 1_000_000, 2));
+    timed("add_noise 1M points", || add_noise(&mut noisy, 0.005, 0.05, 3));
 
-    let bvh = timed("TriangleBvh::new 100k triangles", || {
-        TriangleBvh::new(&mesh)
-    });
+    let bvh = timed("TriangleBvh::new 100k triangles", || TriangleBvh::new(&mesh));
     assert_eq!(bvh.len(), 100_000);
-    let d = timed(
-        "point_to_mesh_distances 1M queries vs 100k triangles",
-        || point_to_mesh_distances(&noisy.positions, &mesh),
-    );
+    let d = timed("point_to_mesh_distances 1M queries vs 100k triangles", || {
+        point_to_mesh_distances(&noisy.positions, &mesh)
+    });
     assert!(d.iter().all(|x| x.is_finite()));
     // Queries spread through the bounding box (up to ~1 unit from the surface) prune less.
     let mut rng = Rng::new(4);
-    let far: Vec<Vec3> = (0..1_000_000)
-        .map(|_| {
-            Vec3::new(
-                rng.f32() * 3.0 - 1.5,
-                rng.f32() * 3.0 - 1.5,
-                rng.f32() - 0.5,
-            )
-        })
-        .collect();
-    let d = timed(
-        "point_to_mesh_distances 1M box-uniform queries vs 100k triangles",
-        || point_to_mesh_distances(&far, &mesh),
-    );
+    let far: Vec<Vec3> =
+        (0..1_000_000).map(|_| Vec3::new(rng.f32() * 3.0 - 1.5, rng.f32() * 3.0 - 1.5, rng.f32() - 0.5)).collect();
+    let d = timed("point_to_mesh_distances 1M box-uniform queries vs 100k triangles", || {
+        point_to_mesh_distances(&far, &mesh)
+    });
     assert!(d.iter().all(|x| x.is_finite()));
 
-    let points = timed("PointBvh::new 1M points", || {
-        PointBvh::new(&cloud.positions[..1_000_000])
-    });
+    let points = timed("PointBvh::new 1M points", || PointBvh::new(&cloud.positions[..1_000_000]));
     assert_eq!(points.len(), 1_000_000);
     let d = timed("point_to_points_distances 1M queries vs 1M points", || {
         point_to_points_distances(&noisy.positions, &cloud.positions[..1_000_000])

@@ -17,15 +17,7 @@ fn run(
     sampling: MeshSampling,
     threads: usize,
 ) -> (Mesh, vstree::SimplifyStats) {
-    let params = SimplifyParams {
-        tree: TreeParams {
-            kind,
-            error,
-            ..TreeParams::default()
-        },
-        sampling,
-        threads,
-    };
+    let params = SimplifyParams { tree: TreeParams { kind, error, ..TreeParams::default() }, sampling, threads };
     simplify(mesh, &params, &mut Progress::none()).unwrap()
 }
 
@@ -33,10 +25,7 @@ fn run(
 fn assert_clean(out: &Mesh) {
     let mut seen = HashSet::new();
     for t in &out.triangles {
-        assert!(
-            t[0] != t[1] && t[1] != t[2] && t[0] != t[2],
-            "collapsed triangle {t:?}"
-        );
+        assert!(t[0] != t[1] && t[1] != t[2] && t[0] != t[2], "collapsed triangle {t:?}");
         let mut key = *t;
         key.sort_unstable();
         assert!(seen.insert(key), "repeated triangle {t:?}");
@@ -53,10 +42,7 @@ fn assert_within_bound(name: &str, input: &Mesh, out: &Mesh, error: f64) {
     let diagonal = input.bounds().unwrap().diagonal();
     let bound = (error.sqrt() as f32) * diagonal;
     let vertices = one_sided(&out.positions, Target::of(input));
-    let surface = one_sided(
-        &shapes::sample_surface(out, 50_000, 1).positions,
-        Target::of(input),
-    );
+    let surface = one_sided(&shapes::sample_surface(out, 50_000, 1).positions, Target::of(input));
     eprintln!(
         "{name} e={error}: vertices max {:.3} mean {:.3}; surface mean {:.3} p99 {:.3} max {:.3} (x bound)",
         vertices.max / bound,
@@ -65,21 +51,9 @@ fn assert_within_bound(name: &str, input: &Mesh, out: &Mesh, error: f64) {
         surface.p99 / bound,
         surface.max / bound
     );
-    assert!(
-        vertices.max <= bound,
-        "{name}: a vertex is {} from the input (bound {bound})",
-        vertices.max
-    );
-    assert!(
-        surface.mean <= 0.5 * bound,
-        "{name}: mean surface distance {} (bound {bound})",
-        surface.mean
-    );
-    assert!(
-        surface.p99 <= 2.0 * bound,
-        "{name}: 99th percentile {} (bound {bound})",
-        surface.p99
-    );
+    assert!(vertices.max <= bound, "{name}: a vertex is {} from the input (bound {bound})", vertices.max);
+    assert!(surface.mean <= 0.5 * bound, "{name}: mean surface distance {} (bound {bound})", surface.mean);
+    assert!(surface.p99 <= 2.0 * bound, "{name}: 99th percentile {} (bound {bound})", surface.p99);
 }
 
 #[test]
@@ -98,34 +72,21 @@ fn sphere_simplifies_within_the_bound_keeping_orientation() {
             assert_within_bound("sphere", &sphere, &out, error);
             let volume = topology::signed_volume(&out);
             let expected = topology::signed_volume(&sphere);
-            assert!(
-                volume > 0.9 * expected,
-                "{kind:?} {error}: volume {volume} vs {expected}: orientation lost?"
-            );
+            assert!(volume > 0.9 * expected, "{kind:?} {error}: volume {volume} vs {expected}: orientation lost?");
         }
     }
 }
 
 #[test]
 fn real_models_simplify_within_the_bound() {
-    for name in [
-        "bunny_zipper.ply",
-        "igea.ply",
-        "armadillo_43k.obj",
-        "happy_buddha_100k.obj",
-        "fandisk.off",
-    ] {
+    for name in ["bunny_zipper.ply", "igea.ply", "armadillo_43k.obj", "happy_buddha_100k.obj", "fandisk.off"] {
         let Some(mesh) = common::load(name) else {
             return;
         };
         for error in [1e-4, 2e-3] {
             let (out, _) = run(&mesh, TreeKind::VsTree, error, MeshSampling::Vertices, 0);
             assert_clean(&out);
-            assert!(
-                out.triangles.len() < mesh.triangles.len() / 2,
-                "{name}: {} triangles",
-                out.triangles.len()
-            );
+            assert!(out.triangles.len() < mesh.triangles.len() / 2, "{name}: {} triangles", out.triangles.len());
             assert_within_bound(name, &mesh, &out, error);
         }
     }
@@ -172,25 +133,12 @@ fn non_manifold_input_is_fine() {
     // (All these faces' planes contain the x axis, so under L2 one cluster would represent
     // them exactly; one sample per cluster keeps every vertex.)
     let params = SimplifyParams {
-        tree: TreeParams {
-            metric: Metric::Density,
-            error: 1.0,
-            ..TreeParams::default()
-        },
+        tree: TreeParams { metric: Metric::Density, error: 1.0, ..TreeParams::default() },
         ..Default::default()
     };
     let (out, _) = simplify(&mesh, &params, &mut Progress::none()).unwrap();
     assert_clean(&out);
-    assert_eq!(
-        out.triangles.len(),
-        3,
-        "the repeat is dropped, the rest kept: {:?}",
-        out.triangles
-    );
+    assert_eq!(out.triangles.len(), 3, "the repeat is dropped, the rest kept: {:?}", out.triangles);
     let first = out.triangles[0].map(|i| out.positions[i as usize]);
-    assert_eq!(
-        first,
-        [0, 1, 2].map(|i| mesh.positions[i]),
-        "the first of a repeated pair keeps its winding"
-    );
+    assert_eq!(first, [0, 1, 2].map(|i| mesh.positions[i]), "the first of a repeated pair keeps its winding");
 }

@@ -12,11 +12,7 @@ fn build(samples: &SampleSet, params: &TreeParams, threads: usize) -> vstree::Vs
 }
 
 fn params(kind: TreeKind, error: f64) -> TreeParams {
-    TreeParams {
-        kind,
-        error,
-        ..TreeParams::default()
-    }
+    TreeParams { kind, error, ..TreeParams::default() }
 }
 
 #[test]
@@ -29,15 +25,10 @@ fn invariants_hold_on_every_real_model() {
         for kind in [TreeKind::VsTree, TreeKind::Octree] {
             for error in [1e-4, 2e-3] {
                 let t = build(&samples, &params(kind, error), 0);
-                t.validate()
-                    .unwrap_or_else(|e| panic!("{name} {kind:?} {error}: {e}"));
+                t.validate().unwrap_or_else(|e| panic!("{name} {kind:?} {error}: {e}"));
                 let s = t.stats();
                 assert_eq!(s.samples, samples.len());
-                assert!(
-                    s.leaves >= 1 && s.leaves <= samples.len(),
-                    "{name}: {} leaves",
-                    s.leaves
-                );
+                assert!(s.leaves >= 1 && s.leaves <= samples.len(), "{name}: {} leaves", s.leaves);
                 if kind == TreeKind::Octree {
                     assert_eq!(s.t_nodes + s.s_nodes, 0, "{name}: the octree has T/S nodes");
                 } else {
@@ -50,25 +41,12 @@ fn invariants_hold_on_every_real_model() {
 
 #[test]
 fn invariants_hold_on_generated_shapes_with_every_metric() {
-    let shapes = [
-        shapes::icosphere(1.0, 5),
-        shapes::torus(1.0, 0.3, 96, 48),
-        shapes::double_torus(),
-    ];
+    let shapes = [shapes::icosphere(1.0, 5), shapes::torus(1.0, 0.3, 96, 48), shapes::double_torus()];
     for mesh in &shapes {
         let samples = SampleSet::from_mesh(mesh, MeshSampling::Vertices).unwrap();
-        for (metric, error) in [
-            (Metric::L2, 1e-5),
-            (Metric::L21, 0.01),
-            (Metric::Density, 16.0),
-        ] {
+        for (metric, error) in [(Metric::L2, 1e-5), (Metric::L21, 0.01), (Metric::Density, 16.0)] {
             for kind in [TreeKind::VsTree, TreeKind::Octree] {
-                let p = TreeParams {
-                    kind,
-                    metric,
-                    error,
-                    ..TreeParams::default()
-                };
+                let p = TreeParams { kind, metric, error, ..TreeParams::default() };
                 let t = build(&samples, &p, 0);
                 t.validate().unwrap();
                 if metric == Metric::Density {
@@ -87,10 +65,7 @@ fn same_tree_with_one_or_two_threads() {
     for kind in [TreeKind::VsTree, TreeKind::Octree] {
         let a = build(&samples, &params(kind, 1e-5), 1);
         let b = build(&samples, &params(kind, 1e-5), 2);
-        assert!(
-            a.nodes == b.nodes && a.frames == b.frames && a.samples == b.samples,
-            "{kind:?}: trees differ"
-        );
+        assert!(a.nodes == b.nodes && a.frames == b.frames && a.samples == b.samples, "{kind:?}: trees differ");
         a.validate().unwrap();
     }
 }
@@ -99,11 +74,7 @@ fn same_tree_with_one_or_two_threads() {
 fn unit_sphere_samples(count: usize) -> SampleSet {
     let cloud = shapes::sample_surface(&shapes::icosphere(1.0, 5), count, 3);
     let positions: Vec<glam::Vec3> = cloud.positions.iter().map(|p| p.normalize()).collect();
-    SampleSet {
-        normals: positions.clone(),
-        origin: (0..count as u32).collect(),
-        positions,
-    }
+    SampleSet { normals: positions.clone(), origin: (0..count as u32).collect(), positions }
 }
 
 #[test]
@@ -129,11 +100,7 @@ fn a_sphere_switches_to_quadtrees_early_and_needs_fewer_clusters() {
         );
         // More even clusters: a smaller spread of samples per cluster relative to the mean.
         let spread = |s: &vstree::tree::TreeStats| s.leaf_size_variance / s.leaf_size_mean.powi(2);
-        eprintln!(
-            "  spread: VS-Tree {:.3}, octree {:.3}",
-            spread(&vs),
-            spread(&oct)
-        );
+        eprintln!("  spread: VS-Tree {:.3}, octree {:.3}", spread(&vs), spread(&oct));
         assert!(spread(&vs) < spread(&oct), "clusters are not more even");
     }
 }
@@ -146,12 +113,8 @@ fn fewer_clusters_than_the_octree_on_real_scans() {
         };
         let samples = common::samples_of(&mesh).unwrap();
         for error in [1e-4, 2e-3] {
-            let vs = build(&samples, &params(TreeKind::VsTree, error), 0)
-                .stats()
-                .leaves;
-            let oct = build(&samples, &params(TreeKind::Octree, error), 0)
-                .stats()
-                .leaves;
+            let vs = build(&samples, &params(TreeKind::VsTree, error), 0).stats().leaves;
+            let oct = build(&samples, &params(TreeKind::Octree, error), 0).stats().leaves;
             eprintln!("{name} {error}: VS-Tree {vs}, octree {oct} clusters");
             assert!(vs < oct, "{name} at {error}: VS-Tree {vs} >= octree {oct}");
         }
@@ -162,40 +125,17 @@ fn fewer_clusters_than_the_octree_on_real_scans() {
 fn graceful_degradation_to_an_octree() {
     // With d_d = 0 the height-field indicator only holds for cells whose samples coincide, so
     // the VS-Tree has exactly the octree's cells; such single-point cells may be T-leaves.
-    let samples =
-        SampleSet::from_mesh(&shapes::torus(1.0, 0.3, 64, 32), MeshSampling::Vertices).unwrap();
-    let strict = TreeParams {
-        d_d: 0.0,
-        ..params(TreeKind::VsTree, 1e-4)
-    };
+    let samples = SampleSet::from_mesh(&shapes::torus(1.0, 0.3, 64, 32), MeshSampling::Vertices).unwrap();
+    let strict = TreeParams { d_d: 0.0, ..params(TreeKind::VsTree, 1e-4) };
     let a = build(&samples, &strict, 0);
     let b = build(&samples, &params(TreeKind::Octree, 1e-4), 0);
     let cells = |t: &vstree::VsTree| {
-        t.nodes
-            .iter()
-            .map(|n| {
-                (
-                    n.start,
-                    n.count,
-                    n.center,
-                    n.half,
-                    n.first_child,
-                    n.child_count,
-                )
-            })
-            .collect::<Vec<_>>()
+        t.nodes.iter().map(|n| (n.start, n.count, n.center, n.half, n.first_child, n.child_count)).collect::<Vec<_>>()
     };
-    assert!(
-        cells(&a) == cells(&b),
-        "the VS-Tree's cells differ from the octree's"
-    );
+    assert!(cells(&a) == cells(&b), "the VS-Tree's cells differ from the octree's");
     for n in a.nodes.iter().filter(|n| n.kind != NodeKind::Volume) {
         let pts = a.samples_of(n);
-        assert!(
-            n.kind == NodeKind::Transition
-                && n.is_leaf()
-                && pts.iter().all(|s| s.position == pts[0].position)
-        );
+        assert!(n.kind == NodeKind::Transition && n.is_leaf() && pts.iter().all(|s| s.position == pts[0].position));
     }
 }
 
@@ -205,28 +145,15 @@ fn mean_t_depth(t: &vstree::VsTree) -> f64 {
         .nodes
         .iter()
         .filter(|n| n.kind == NodeKind::Transition)
-        .fold((0.0, 0.0), |(s, c), n| {
-            (
-                s + f64::from(n.depth) * f64::from(n.count),
-                c + f64::from(n.count),
-            )
-        });
+        .fold((0.0, 0.0), |(s, c), n| (s + f64::from(n.depth) * f64::from(n.count), c + f64::from(n.count)));
     sum / count
 }
 
 #[test]
 fn a_stricter_indicator_pushes_the_t_layer_deeper() {
-    let samples = SampleSet::from_mesh(
-        &shapes::bumpy_sphere(1.0, 0.15, 6.0, 6),
-        MeshSampling::Vertices,
-    )
-    .unwrap();
+    let samples = SampleSet::from_mesh(&shapes::bumpy_sphere(1.0, 0.15, 6.0, 6), MeshSampling::Vertices).unwrap();
     let loose = build(&samples, &params(TreeKind::VsTree, 1e-5), 0);
-    let strict = TreeParams {
-        d_a: 0.8,
-        d_d: 0.05,
-        ..params(TreeKind::VsTree, 1e-5)
-    };
+    let strict = TreeParams { d_a: 0.8, d_d: 0.05, ..params(TreeKind::VsTree, 1e-5) };
     let strict = build(&samples, &strict, 0);
     let (l, s) = (loose.stats(), strict.stats());
     eprintln!(
@@ -242,8 +169,7 @@ fn a_stricter_indicator_pushes_the_t_layer_deeper() {
 
 #[test]
 fn locate_finds_the_leaf_of_every_sample() {
-    let samples =
-        SampleSet::from_mesh(&shapes::torus(1.0, 0.3, 64, 32), MeshSampling::Vertices).unwrap();
+    let samples = SampleSet::from_mesh(&shapes::torus(1.0, 0.3, 64, 32), MeshSampling::Vertices).unwrap();
     let t = build(&samples, &params(TreeKind::VsTree, 1e-5), 0);
     for leaf in t.leaves() {
         for s in t.samples_of(&t.nodes[leaf]) {

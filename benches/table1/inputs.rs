@@ -23,10 +23,7 @@ const EXTENSIONS: [&str; 5] = ["ply", "obj", "off", "xyz", "pwn"];
 /// whose stem is in `only`. Files that fail to read are reported and skipped.
 pub fn models(data: &Path, only: Option<&[String]>) -> Vec<Input> {
     let Ok(entries) = std::fs::read_dir(data) else {
-        eprintln!(
-            "table1: {} is absent: only generated inputs will run",
-            data.display()
-        );
+        eprintln!("table1: {} is absent: only generated inputs will run", data.display());
         return Vec::new();
     };
     let mut paths: Vec<PathBuf> = entries
@@ -45,9 +42,7 @@ pub fn models(data: &Path, only: Option<&[String]>) -> Vec<Input> {
 }
 
 fn stem(path: &Path) -> String {
-    path.file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default()
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
 /// The mesh at `path` with its vertex samples, or `None` for point clouds and unreadable files.
@@ -69,12 +64,7 @@ fn model(path: &Path) -> Option<Input> {
             return None;
         }
     };
-    Some(Input {
-        name: stem(path),
-        path: Some(path.to_path_buf()),
-        mesh: Some(mesh),
-        samples,
-    })
+    Some(Input { name: stem(path), path: Some(path.to_path_buf()), mesh: Some(mesh), samples })
 }
 
 /// The surface dense clouds are drawn on: igea (a model of the paper) with smooth vertex
@@ -92,10 +82,7 @@ pub fn cloud_surface(data: &Path) -> (String, Mesh) {
             return ("igea".into(), mesh);
         }
     }
-    (
-        "bumpy sphere".into(),
-        shapes::bumpy_sphere(1.0, 0.2, 6.0, 7),
-    )
+    ("bumpy sphere".into(), shapes::bumpy_sphere(1.0, 0.2, 6.0, 7))
 }
 
 /// `count` samples drawn uniformly by area on `surface` (fixed seed), with their normals.
@@ -103,11 +90,7 @@ pub fn cloud(surface: &Mesh, count: usize) -> SampleSet {
     let cloud = shapes::sample_surface(surface, count, 2006);
     // `sample_surface` already gives unit normals: move them instead of copying.
     let normals = cloud.normals.unwrap_or_default();
-    SampleSet {
-        origin: (0..cloud.positions.len() as u32).collect(),
-        positions: cloud.positions,
-        normals,
-    }
+    SampleSet { origin: (0..cloud.positions.len() as u32).collect(), positions: cloud.positions, normals }
 }
 
 /// `1000000` as `1M`, `1500` as `1.5k`.

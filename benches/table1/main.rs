@@ -110,10 +110,7 @@ fn v_split(s: &str) -> Vec<String> {
 
 fn main() {
     // `cargo bench` adds `--bench`; it means nothing here.
-    let args: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| a != "--bench")
-        .collect();
+    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     if args.iter().any(|a| a == "--help" || a == "-h") {
         println!("{USAGE}");
@@ -161,10 +158,7 @@ fn memory_child(args: &[String], root: &Path) {
         _ => TreeKind::VsTree,
     };
     let bound: f64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1e-4);
-    let count: usize = args
-        .get(2)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(5_000_000);
+    let count: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(5_000_000);
     let options = Options::parse(args.get(3..).unwrap_or(&[]), root).expect("child options");
     memory::child(&options.data, kind, bound, count, options.threads);
 }
@@ -180,10 +174,7 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
 
     let models = inputs::models(&o.data, o.models.as_deref());
     if models.is_empty() {
-        notes.push(format!(
-            "No model found in `{}`: only generated clouds ran.",
-            shown(&o.data, root)
-        ));
+        notes.push(format!("No model found in `{}`: only generated clouds ran.", shown(&o.data, root)));
     }
     for input in &models {
         eprintln!("table1: {} ({} samples)", input.name, input.samples.len());
@@ -230,11 +221,9 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
     drop(surface);
 
     let mut memory = Vec::new();
-    if let (true, Some(&count), Some(&bound)) = (
-        o.memory,
-        o.big.iter().max(),
-        o.bounds.iter().min_by(|a, b| a.total_cmp(b)),
-    ) {
+    if let (true, Some(&count), Some(&bound)) =
+        (o.memory, o.big.iter().max(), o.bounds.iter().min_by(|a, b| a.total_cmp(b)))
+    {
         for kind in KINDS {
             eprintln!("table1: peak memory, {kind:?}, {count} samples");
             match memory::measure(&o.data, kind, bound, count, o.threads) {
@@ -265,19 +254,12 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
 
 /// `path` as the doc should show it: relative to the project root when possible.
 fn shown(path: &Path, root: &Path) -> String {
-    path.strip_prefix(root)
-        .unwrap_or(path)
-        .display()
-        .to_string()
+    path.strip_prefix(root).unwrap_or(path).display().to_string()
 }
 
 /// Table rows of one input at every bound and, for meshes, its octree and VS-Tree
 /// simplifications.
-fn mesh_rows(
-    input: &Input,
-    o: &Options,
-    threads: &Threads,
-) -> vstree::Result<(Vec<Row>, Vec<Method>)> {
+fn mesh_rows(input: &Input, o: &Options, threads: &Threads) -> vstree::Result<(Vec<Row>, Vec<Method>)> {
     let big = input.samples.len() >= 1_000_000;
     let runs = if big { o.big_runs } else { o.runs };
     let diagonal = vstree::Aabb::of(&input.samples.positions).map_or(1.0, |b| b.diagonal());
@@ -298,9 +280,7 @@ fn mesh_rows(
             for (k, kind) in KINDS.into_iter().enumerate() {
                 let out = measure::simplified(mesh, kind, bound, o.threads, runs)?;
                 let one = match kind {
-                    TreeKind::VsTree => {
-                        Some(measure::simplified(mesh, kind, bound, 1, runs)?.seconds)
-                    }
+                    TreeKind::VsTree => Some(measure::simplified(mesh, kind, bound, 1, runs)?.seconds),
                     TreeKind::Octree => None,
                 };
                 let d = measure::distances(mesh, &input.samples.positions, diagonal, &out.mesh);
@@ -331,11 +311,8 @@ fn peer_rows(input: &Input, rows: &[Row], o: &Options, root: &Path) -> Result<Ve
     let (Some(path), Some(mesh)) = (&input.path, &input.mesh) else {
         return Ok(Vec::new());
     };
-    let targets: Vec<(f64, usize)> = rows
-        .iter()
-        .filter_map(|r| r.triangles.map(|[_, vs]| (r.bound, vs)))
-        .filter(|&(_, t)| t > 0)
-        .collect();
+    let targets: Vec<(f64, usize)> =
+        rows.iter().filter_map(|r| r.triangles.map(|[_, vs]| (r.bound, vs))).filter(|&(_, t)| t > 0).collect();
     let mut unique: Vec<usize> = targets.iter().map(|&(_, t)| t).collect();
     unique.sort_unstable();
     unique.dedup();

@@ -12,11 +12,7 @@ pub const KINDS: [TreeKind; 2] = [TreeKind::Octree, TreeKind::VsTree];
 
 /// Tree parameters: the paper's defaults with the L2 metric at `bound`.
 pub fn params(kind: TreeKind, bound: f64) -> TreeParams {
-    TreeParams {
-        kind,
-        error: bound,
-        ..TreeParams::default()
-    }
+    TreeParams { kind, error: bound, ..TreeParams::default() }
 }
 
 /// The median of `values` (mean of the two middle ones for an even count; 0 when empty).
@@ -54,11 +50,7 @@ impl Build {
 
 /// The tree's figures, and how many of its leaves are S-nodes.
 fn figures(tree: &VsTree) -> (TreeStats, usize) {
-    let surface = tree
-        .nodes
-        .iter()
-        .filter(|n| n.is_leaf() && n.kind == NodeKind::Surface)
-        .count();
+    let surface = tree.nodes.iter().filter(|n| n.is_leaf() && n.kind == NodeKind::Surface).count();
     (tree.stats(), surface)
 }
 
@@ -85,12 +77,7 @@ pub fn builds(
         let mut last = (TreeStats::default(), 0);
         for _ in 0..repeat {
             let start = Instant::now();
-            let tree = tree::build(
-                samples,
-                &params(KINDS[k], bound),
-                threads,
-                &mut Progress::none(),
-            )?;
+            let tree = tree::build(samples, &params(KINDS[k], bound), threads, &mut Progress::none())?;
             total += start.elapsed().as_secs_f64();
             last = figures(&tree); // the tree is dropped outside the timed span
         }
@@ -100,9 +87,7 @@ pub fn builds(
     if warm_up {
         for (k, r) in repeat.iter_mut().enumerate() {
             let (seconds, _) = build(k, 1)?;
-            *r = (MIN_SAMPLE_SECONDS / seconds.max(1e-6))
-                .ceil()
-                .clamp(1.0, 1000.0) as usize;
+            *r = (MIN_SAMPLE_SECONDS / seconds.max(1e-6)).ceil().clamp(1.0, 1000.0) as usize;
         }
     }
     for run in 0..runs.max(1) {
@@ -113,11 +98,7 @@ pub fn builds(
             stats[k] = s;
         }
     }
-    Ok([0, 1].map(|k| Build {
-        seconds: median(&times[k]),
-        stats: stats[k].0,
-        surface_leaves: stats[k].1,
-    }))
+    Ok([0, 1].map(|k| Build { seconds: median(&times[k]), stats: stats[k].0, surface_leaves: stats[k].1 }))
 }
 
 /// A simplified mesh and the median time it took.
@@ -128,18 +109,8 @@ pub struct Simplified {
 
 /// Simplifies `mesh` with vertex samples `runs` times (the whole call: samples, tree,
 /// clustering) on `threads` threads (0 = all); the median time and the last output.
-pub fn simplified(
-    mesh: &Mesh,
-    kind: TreeKind,
-    bound: f64,
-    threads: usize,
-    runs: usize,
-) -> vstree::Result<Simplified> {
-    let params = SimplifyParams {
-        tree: params(kind, bound),
-        sampling: MeshSampling::Vertices,
-        threads,
-    };
+pub fn simplified(mesh: &Mesh, kind: TreeKind, bound: f64, threads: usize, runs: usize) -> vstree::Result<Simplified> {
+    let params = SimplifyParams { tree: params(kind, bound), sampling: MeshSampling::Vertices, threads };
     let mut times = Vec::new();
     let mut out = Mesh::default();
     for _ in 0..runs.max(1) {
@@ -148,10 +119,7 @@ pub fn simplified(
         times.push(start.elapsed().as_secs_f64());
         out = mesh;
     }
-    Ok(Simplified {
-        mesh: out,
-        seconds: median(&times),
-    })
+    Ok(Simplified { mesh: out, seconds: median(&times) })
 }
 
 /// Points sampled on a simplified surface to measure its distance to the input.
@@ -181,10 +149,6 @@ pub fn distances(input: &Mesh, input_points: &[Vec3], diagonal: f32, output: &Me
     let on_output = sample_surface(output, SURFACE_SAMPLES, 31).positions;
     Distances {
         out_in: relative(&on_output, Target::Triangles(input)),
-        in_out: if output.triangles.is_empty() {
-            None
-        } else {
-            relative(input_points, Target::Triangles(output))
-        },
+        in_out: if output.triangles.is_empty() { None } else { relative(input_points, Target::Triangles(output)) },
     }
 }

@@ -50,12 +50,7 @@ impl Memory {
 fn status_bytes(field: &str) -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with(field))?;
-    let kb: u64 = line[field.len()..]
-        .trim()
-        .trim_end_matches("kB")
-        .trim()
-        .parse()
-        .ok()?;
+    let kb: u64 = line[field.len()..].trim().trim_end_matches("kB").trim().parse().ok()?;
     Some(kb * 1024)
 }
 
@@ -68,38 +63,21 @@ pub fn child(data: &Path, kind: TreeKind, bound: f64, count: usize, threads: usi
     let threads = Threads::new(threads).expect("thread pool");
     let reset = std::fs::write("/proc/self/clear_refs", "5").is_ok();
     let baseline = status_bytes("VmRSS:").unwrap_or(0);
-    let tree = tree::build(
-        &samples,
-        &params(kind, bound),
-        &threads,
-        &mut Progress::none(),
-    )
-    .expect("tree build");
+    let tree = tree::build(&samples, &params(kind, bound), &threads, &mut Progress::none()).expect("tree build");
     let peak = status_bytes("VmHWM:").unwrap_or(0);
     std::hint::black_box(&tree);
     println!("memory {baseline} {peak} {}", u8::from(reset));
 }
 
 /// Runs a child for one build and reads its report.
-pub fn measure(
-    data: &Path,
-    kind: TreeKind,
-    bound: f64,
-    count: usize,
-    threads: usize,
-) -> Result<Memory, String> {
+pub fn measure(data: &Path, kind: TreeKind, bound: f64, count: usize, threads: usize) -> Result<Memory, String> {
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
     let kind_arg = match kind {
         TreeKind::Octree => "octree",
         TreeKind::VsTree => "vstree",
     };
     let output = Command::new(exe)
-        .args([
-            "--memory-child",
-            kind_arg,
-            &bound.to_string(),
-            &count.to_string(),
-        ])
+        .args(["--memory-child", kind_arg, &bound.to_string(), &count.to_string()])
         .arg("--data")
         .arg(data)
         .args(["--threads", &threads.to_string()])
@@ -109,29 +87,14 @@ pub fn measure(
         .output()
         .map_err(|e| e.to_string())?;
     let text = String::from_utf8_lossy(&output.stdout);
-    let line = text
-        .lines()
-        .find_map(|l| l.strip_prefix("memory "))
-        .ok_or_else(|| {
-            format!(
-                "no report from the child ({}): {}",
-                output.status,
-                String::from_utf8_lossy(&output.stderr).trim()
-            )
-        })?;
-    let fields: Vec<u64> = line
-        .split_whitespace()
-        .filter_map(|f| f.parse().ok())
-        .collect();
+    let line = text.lines().find_map(|l| l.strip_prefix("memory ")).ok_or_else(|| {
+        format!("no report from the child ({}): {}", output.status, String::from_utf8_lossy(&output.stderr).trim())
+    })?;
+    let fields: Vec<u64> = line.split_whitespace().filter_map(|f| f.parse().ok()).collect();
     match fields[..] {
-        [baseline, peak, reset] if peak > 0 => Ok(Memory {
-            kind,
-            bound,
-            samples: count,
-            baseline,
-            peak,
-            reset: reset == 1,
-        }),
+        [baseline, peak, reset] if peak > 0 => {
+            Ok(Memory { kind, bound, samples: count, baseline, peak, reset: reset == 1 })
+        }
         _ => Err(format!("unreadable report from the child: {line}")),
     }
 }

@@ -21,13 +21,7 @@ pub struct PeerRun {
 
 /// Runs the peers on the mesh file `input` for each of `targets` (triangle counts), `runs`
 /// timed runs each. The script's progress goes to this process's stderr.
-pub fn run(
-    root: &Path,
-    input: &Path,
-    name: &str,
-    targets: &[usize],
-    runs: usize,
-) -> Result<Vec<PeerRun>, String> {
+pub fn run(root: &Path, input: &Path, name: &str, targets: &[usize], runs: usize) -> Result<Vec<PeerRun>, String> {
     let script = root.join("benches").join("peers.py");
     let out_dir = root.join("target").join("bench-peers");
     let mut command = Command::new("python3");
@@ -48,10 +42,7 @@ pub fn run(
     if !output.status.success() {
         return Err(format!("{} failed ({})", script.display(), output.status));
     }
-    let runs: Vec<PeerRun> = String::from_utf8_lossy(&output.stdout)
-        .lines()
-        .filter_map(parse)
-        .collect();
+    let runs: Vec<PeerRun> = String::from_utf8_lossy(&output.stdout).lines().filter_map(parse).collect();
     if runs.is_empty() {
         return Err(format!("{} reported nothing", script.display()));
     }

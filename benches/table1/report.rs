@@ -92,21 +92,16 @@ pub fn load_average() -> String {
 fn machine() -> String {
     let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
     let field = |text: &str, key: &str| {
-        text.lines()
-            .find(|l| l.starts_with(key))
-            .and_then(|l| l.split(':').nth(1))
-            .map(|v| v.trim().to_string())
+        text.lines().find(|l| l.starts_with(key)).and_then(|l| l.split(':').nth(1)).map(|v| v.trim().to_string())
     };
     let cpu = field(&cpuinfo, "model name").unwrap_or_else(|| "unknown CPU".into());
     let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
     let meminfo = std::fs::read_to_string("/proc/meminfo").unwrap_or_default();
     let memory = field(&meminfo, "MemTotal")
         .and_then(|v| v.trim_end_matches("kB").trim().parse::<f64>().ok())
-        .map_or("unknown memory".into(), |kb| {
-            format!("{:.1} GiB RAM", kb / 1024.0 / 1024.0)
-        });
-    let kernel = std::fs::read_to_string("/proc/sys/kernel/osrelease")
-        .map_or("unknown".into(), |s| s.trim().to_string());
+        .map_or("unknown memory".into(), |kb| format!("{:.1} GiB RAM", kb / 1024.0 / 1024.0));
+    let kernel =
+        std::fs::read_to_string("/proc/sys/kernel/osrelease").map_or("unknown".into(), |s| s.trim().to_string());
     let rustc = std::process::Command::new(std::env::var("RUSTC").unwrap_or("rustc".into()))
         .arg("--version")
         .output()
@@ -114,17 +109,12 @@ fn machine() -> String {
         .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
         .filter(|s| !s.is_empty())
         .unwrap_or_else(|| "rustc unknown".into());
-    format!(
-        "{cpus} logical CPUs (`nproc`), {cpu}, {memory}, Linux {kernel}, {rustc}, {}",
-        today()
-    )
+    format!("{cpus} logical CPUs (`nproc`), {cpu}, {memory}, Linux {kernel}, {rustc}, {}", today())
 }
 
 /// Today's date (UTC) as YYYY-MM-DD, from the civil-from-days algorithm (H. Hinnant).
 fn today() -> String {
-    let secs = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs()) as i64;
+    let secs = SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| d.as_secs()) as i64;
     let z = secs.div_euclid(86_400) + 719_468;
     let era = z.div_euclid(146_097);
     let doe = z - era * 146_097;
@@ -166,18 +156,12 @@ fn percent(x: f64) -> String {
 /// A distance relative to the diagonal, as a percentage with three significant digits.
 fn relative(x: f64) -> String {
     let p = 100.0 * x;
-    let decimals = if p == 0.0 {
-        3
-    } else {
-        (2 - p.abs().log10().floor() as i32).clamp(0, 5) as usize
-    };
+    let decimals = if p == 0.0 { 3 } else { (2 - p.abs().log10().floor() as i32).clamp(0, 5) as usize };
     format!("{p:.decimals$}%")
 }
 
 fn mean_max(d: Option<(f64, f64)>) -> String {
-    d.map_or("—".into(), |(mean, max)| {
-        format!("{} / {}", relative(mean), relative(max))
-    })
+    d.map_or("—".into(), |(mean, max)| format!("{} / {}", relative(mean), relative(max)))
 }
 
 fn bound(b: f64) -> String {
@@ -217,11 +201,7 @@ impl Report {
             c.load_end,
             seconds(c.seconds)
         );
-        let threads = if c.threads == 0 {
-            "all cores".to_string()
-        } else {
-            c.threads.to_string()
-        };
+        let threads = if c.threads == 0 { "all cores".to_string() } else { c.threads.to_string() };
         let _ = writeln!(
             md,
             "- Times are medians of {} runs ({} for inputs of 1M samples or more), octree and \
@@ -277,11 +257,7 @@ impl Report {
              |---|--:|--:|--:|--:|--:|--:|--:|\n",
         );
         for one in &self.one_thread {
-            let Some(all) = self
-                .rows
-                .iter()
-                .find(|r| r.input == one.input && r.bound == one.bound)
-            else {
+            let Some(all) = self.rows.iter().find(|r| r.input == one.input && r.bound == one.bound) else {
                 continue;
             };
             let _ = writeln!(
@@ -317,9 +293,8 @@ impl Report {
         );
         for r in &self.rows {
             let vs = &r.builds[1].stats;
-            let (oct_tris, vs_tris) = r.triangles.map_or(("—".into(), "—".into()), |[o, v]| {
-                (thousands(o), thousands(v))
-            });
+            let (oct_tris, vs_tris) =
+                r.triangles.map_or(("—".into(), "—".into()), |[o, v]| (thousands(o), thousands(v)));
             let _ = writeln!(
                 md,
                 "| {} | {} | {:.2} | {:.2} | {:.2} | {}–{} | {} | {} | {} | {} |",
@@ -402,9 +377,7 @@ impl Report {
             );
         }
         if self.memory.iter().any(|m| !m.reset) {
-            md.push_str(
-                "\nThe peak counter could not be reset: peaks may include making the samples.\n",
-            );
+            md.push_str("\nThe peak counter could not be reset: peaks may include making the samples.\n");
         }
         md.push('\n');
     }
@@ -469,16 +442,8 @@ impl Report {
             );
         }
         if !self.memory.is_empty() {
-            let total = self
-                .memory
-                .iter()
-                .map(Memory::total_per_sample)
-                .fold(0.0, f64::max);
-            let over = self
-                .memory
-                .iter()
-                .map(Memory::build_per_sample)
-                .fold(0.0, f64::max);
+            let total = self.memory.iter().map(Memory::total_per_sample).fold(0.0, f64::max);
+            let over = self.memory.iter().map(Memory::build_per_sample).fold(0.0, f64::max);
             let _ = writeln!(
                 md,
                 "- Peak memory under {BYTES_TARGET} B/sample: {} counting everything \

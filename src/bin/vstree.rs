@@ -66,6 +66,13 @@ enum Command {
         /// gives an open mesh (0 = keep the closed surface).
         #[arg(long, default_value_t = 0.0)]
         trim: f32,
+        /// Re-orient the normals the cloud already has (consistent by spanning-tree
+        /// propagation, then facing outward). Clouds without normals always get them estimated.
+        #[arg(long)]
+        reorient: bool,
+        /// Neighbours used to estimate normals (3-256).
+        #[arg(long, default_value_t = vstree::normals::DEFAULT_NEIGHBOURS)]
+        neighbours: usize,
         /// Write PLY as text instead of binary.
         #[arg(long)]
         ascii: bool,
@@ -171,13 +178,7 @@ fn main() -> ExitCode {
 
 fn run(command: Command) -> vstree::Result<()> {
     match command {
-        Command::Simplify {
-            input,
-            output,
-            tree,
-            sampling,
-            ascii,
-        } => {
+        Command::Simplify { input, output, tree, sampling, ascii } => {
             tree.params().check()?; // before reading what may be a large file
             let (mesh, read_s) = timed(|| io::read(&input))?;
             let params = SimplifyParams {
@@ -188,25 +189,17 @@ fn run(command: Command) -> vstree::Result<()> {
                 },
                 threads: tree.threads,
             };
-            let (out, stats) =
-                with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
-            let (_, write_s) =
-                timed(|| io::write_with(&output, &out, &io::WriteOptions { ascii }))?;
+            let (out, stats) = with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
+            let (_, write_s) = timed(|| io::write_with(&output, &out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
                 print_simplify(&input, &output, &stats, read_s, write_s);
             }
             Ok(())
         }
-        Command::Reconstruct {
-            input,
-            output,
-            tree,
-            target,
-            levels,
-            trim,
-            ascii,
-        } => {
+        Command::Reconstruct { input, output, tree, target, levels, trim, reorient, neighbours, ascii } => {
+            let normals = vstree::normals::NormalParams { neighbours, reorient_given: reorient, ..Default::default() };
             let params = ReconstructParams {
+                normals,
                 tree: tree.params(),
                 target_distance: target,
                 max_levels: levels,
@@ -217,28 +210,14 @@ fn run(command: Command) -> vstree::Result<()> {
             params.check()?;
             let (mut cloud, read_s) = timed(|| io::read(&input))?;
             cloud.triangles.clear();
-            let (out, stats) = with_progress(tree.quiet, |progress| {
-                reconstruct(&cloud, &params, progress)
-            })?;
-            let (_, write_s) =
-                timed(|| io::write_with(&output, &out, &io::WriteOptions { ascii }))?;
+            let (out, stats) = with_progress(tree.quiet, |progress| reconstruct(&cloud, &params, progress))?;
+            let (_, write_s) = timed(|| io::write_with(&output, &out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
-                print_reconstruct(
-                    &input,
-                    &output,
-                    cloud.positions.len(),
-                    &stats,
-                    read_s,
-                    write_s,
-                );
+                print_reconstruct(&input, &output, cloud.positions.len(), &stats, read_s, write_s);
             }
             Ok(())
         }
-        Command::Stats {
-            input,
-            tree,
-            compare,
-        } => {
+        Command::Stats { input, tree, compare } => {
             tree.params().check()?;
             let mesh = io::read(&input)?;
             let samples = if mesh.is_point_cloud() {
@@ -249,23 +228,14 @@ fn run(command: Command) -> vstree::Result<()> {
             let threads = Threads::new(tree.threads)?;
             let mut kinds = vec![tree.params()];
             if compare {
-                let other = if kinds[0].kind == TreeKind::VsTree {
-                    TreeKind::Octree
-                } else {
-                    TreeKind::VsTree
-                };
-                kinds.push(TreeParams {
-                    kind: other,
-                    ..kinds[0]
-                });
+                let other = if kinds[0].kind == TreeKind::VsTree { TreeKind::Octree } else { TreeKind::VsTree };
+                kinds.push(TreeParams { kind: other, ..kinds[0] });
             }
             println!("{}: {} samples", input.display(), samples.len());
             let mut leaves = Vec::new();
             for params in kinds {
                 let (built, seconds) = timed(|| {
-                    with_progress(tree.quiet, |progress| {
-                        vstree::tree::build(&samples, &params, &threads, progress)
-                    })
+                    with_progress(tree.quiet, |progress| vstree::tree::build(&samples, &params, &threads, progress))
                 })?;
                 let stats = built.stats();
                 println!("{:?}: built in {:.3} s", params.kind, seconds);
@@ -273,10 +243,7 @@ fn run(command: Command) -> vstree::Result<()> {
                 leaves.push(stats.leaves);
             }
             if let [first, second] = leaves[..] {
-                println!(
-                    "clusters: {first} vs {second} ({:+.1}%)",
-                    100.0 * (first as f64 / second as f64 - 1.0)
-                );
+                println!("clusters: {first} vs {second} ({:+.1}%)", 100.0 * (first as f64 / second as f64 - 1.0));
             }
             Ok(())
         }
@@ -290,18 +257,10 @@ fn timed<T>(f: impl FnOnce() -> vstree::Result<T>) -> vstree::Result<(T, f64)> {
 }
 
 /// Runs `f` with a progress bar on stderr (drawn only when stderr is a terminal).
-fn with_progress<T>(
-    quiet: bool,
-    f: impl FnOnce(&mut Progress) -> vstree::Result<T>,
-) -> vstree::Result<T> {
-    let bar = if quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(1000)
-    };
+fn with_progress<T>(quiet: bool, f: impl FnOnce(&mut Progress) -> vstree::Result<T>) -> vstree::Result<T> {
+    let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(
-        ProgressStyle::with_template("{spinner} {msg:20} [{bar:40}] {percent:>3}% {elapsed}")
-            .expect("static template"),
+        ProgressStyle::with_template("{spinner} {msg:20} [{bar:40}] {percent:>3}% {elapsed}").expect("static template"),
     );
     let mut callback = |fraction: f32, stage: &str| {
         bar.set_message(stage.to_string());
@@ -314,10 +273,7 @@ fn with_progress<T>(
 }
 
 fn print_tree(s: &TreeStats) {
-    println!(
-        "  nodes: {} (V {}, T {}, S {}), depth {}",
-        s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.max_depth
-    );
+    println!("  nodes: {} (V {}, T {}, S {}), depth {}", s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.max_depth);
     if s.t_nodes > 0 {
         println!("  T-layer depth: {}..{}", s.t_depth_min, s.t_depth_max);
     }
@@ -328,49 +284,28 @@ fn print_tree(s: &TreeStats) {
 }
 
 fn print_simplify(input: &Path, output: &Path, s: &SimplifyStats, read_s: f64, write_s: f64) {
-    println!(
-        "{}: {} vertices, {} triangles",
-        input.display(),
-        s.input_vertices,
-        s.input_triangles
-    );
+    println!("{}: {} vertices, {} triangles", input.display(), s.input_vertices, s.input_triangles);
     println!("samples: {}", s.tree.samples);
     print_tree(&s.tree);
-    println!(
-        "{}: {} vertices, {} triangles",
-        output.display(),
-        s.output_vertices,
-        s.output_triangles
-    );
+    println!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
     println!(
         "time: read {:.3} s, samples {:.3} s, tree {:.3} s, clustering {:.3} s, write {:.3} s",
         read_s, s.seconds_samples, s.seconds_tree, s.seconds_cluster, write_s
     );
 }
 
-fn print_reconstruct(
-    input: &Path,
-    output: &Path,
-    points: usize,
-    s: &ReconstructStats,
-    read_s: f64,
-    write_s: f64,
-) {
+fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &ReconstructStats, read_s: f64, write_s: f64) {
     println!("{}: {} points", input.display(), points);
+    if s.normals.estimated > 0 {
+        println!("normals: {} estimated from {} neighbours", s.normals.estimated, s.normals.neighbours);
+    }
+    if let Some(o) = &s.normals.orient {
+        println!("orientation: {} components, {} flipped", o.components, o.flipped);
+    }
     print_tree(&s.tree);
-    let genus = s
-        .base_genus
-        .map_or("not a closed manifold".to_string(), |g| {
-            format!("genus {g}")
-        });
-    println!(
-        "grid: {} cells across, {} triangles polygonised",
-        s.grid_cells, s.fine_triangles
-    );
-    println!(
-        "M0: {} vertices, {} triangles, {genus}, error {:.2e}",
-        s.base_vertices, s.base_triangles, s.base_error
-    );
+    let genus = s.base_genus.map_or("not a closed manifold".to_string(), |g| format!("genus {g}"));
+    println!("grid: {} cells across, {} triangles polygonised", s.grid_cells, s.fine_triangles);
+    println!("M0: {} vertices, {} triangles, {genus}, error {:.2e}", s.base_vertices, s.base_triangles, s.base_error);
     for (k, level) in s.levels.iter().enumerate() {
         println!(
             "level {}: {} new vertices, {} displaced by the quadtrees",
@@ -379,24 +314,13 @@ fn print_reconstruct(
             level.displaced
         );
     }
-    println!(
-        "error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)",
-        s.final_error, s.final_max_error
-    );
+    println!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
     if s.trimmed_triangles > 0 {
-        println!(
-            "trimmed: {} triangles far from the samples",
-            s.trimmed_triangles
-        );
+        println!("trimmed: {} triangles far from the samples", s.trimmed_triangles);
     }
+    println!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
     println!(
-        "{}: {} vertices, {} triangles",
-        output.display(),
-        s.output_vertices,
-        s.output_triangles
-    );
-    println!(
-        "time: read {:.3} s, tree {:.3} s, base mesh {:.3} s, refinement {:.3} s, trim {:.3} s, write {:.3} s",
-        read_s, s.seconds_tree, s.seconds_base, s.seconds_refine, s.seconds_trim, write_s
+        "time: read {:.3} s, normals {:.3} s, tree {:.3} s, base mesh {:.3} s, refinement {:.3} s, trim {:.3} s, write {:.3} s",
+        read_s, s.seconds_normals, s.seconds_tree, s.seconds_base, s.seconds_refine, s.seconds_trim, write_s
     );
 }

@@ -13,9 +13,7 @@ pub(crate) fn vertex_index(value: i64, vertex_count: usize) -> Result<u32, Strin
         Ok(i) if i < vertex_count => {
             u32::try_from(i).map_err(|_| format!("uses vertex {i}, beyond the 32-bit index range"))
         }
-        _ => Err(format!(
-            "uses vertex {value}, but there are only {vertex_count} vertices"
-        )),
+        _ => Err(format!("uses vertex {value}, but there are only {vertex_count} vertices")),
     }
 }
 
@@ -27,10 +25,7 @@ pub(crate) fn push_fan(polygon: &[u32], triangles: &mut Vec<[u32; 3]>) -> Result
             triangles.extend(rest.windows(2).map(|pair| [*first, pair[0], pair[1]]));
             Ok(())
         }
-        _ => Err(format!(
-            "has {} vertices, but a face needs at least 3",
-            polygon.len()
-        )),
+        _ => Err(format!("has {} vertices, but a face needs at least 3", polygon.len())),
     }
 }
 
@@ -39,10 +34,7 @@ pub(crate) fn finite_position(p: Vec3) -> Result<Vec3, String> {
     if p.is_finite() {
         Ok(p)
     } else {
-        Err(format!(
-            "has a NaN or infinite coordinate ({}, {}, {})",
-            p.x, p.y, p.z
-        ))
+        Err(format!("has a NaN or infinite coordinate ({}, {}, {})", p.x, p.y, p.z))
     }
 }
 
@@ -57,10 +49,7 @@ pub(crate) fn vertex_count_fits(count: usize) -> Result<(), String> {
     if u32::try_from(count).is_ok() {
         Ok(())
     } else {
-        Err(format!(
-            "{count} vertices; at most {} are supported",
-            u32::MAX
-        ))
+        Err(format!("{count} vertices; at most {} are supported", u32::MAX))
     }
 }
 
@@ -73,9 +62,7 @@ mod tests {
         let mut tris = Vec::new();
         push_fan(&[0, 1, 2, 3, 4], &mut tris).unwrap();
         assert_eq!(tris, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
-        assert!(push_fan(&[0, 1], &mut tris)
-            .unwrap_err()
-            .contains("2 vertices"));
+        assert!(push_fan(&[0, 1], &mut tris).unwrap_err().contains("2 vertices"));
         assert!(push_fan(&[], &mut tris).is_err());
     }
 

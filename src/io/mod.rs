@@ -89,7 +89,5 @@ pub fn write_with(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<()
 }
 
 fn format_of(path: &Path) -> Result<Format> {
-    Format::from_path(path).ok_or_else(|| Error::UnsupportedFormat {
-        path: path.to_path_buf(),
-    })
+    Format::from_path(path).ok_or_else(|| Error::UnsupportedFormat { path: path.to_path_buf() })
 }

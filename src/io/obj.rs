@@ -48,10 +48,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
 
 /// Concatenates tobj's models, offsetting each one's indices.
 fn merge(models: &[tobj::Model], path: &Path) -> Result<Mesh> {
-    let mut mesh = Mesh {
-        normals: Some(Vec::new()),
-        ..Mesh::default()
-    };
+    let mut mesh = Mesh { normals: Some(Vec::new()), ..Mesh::default() };
     for model in models {
         let m = &model.mesh;
         let offset = u32::try_from(mesh.positions.len())
@@ -65,20 +62,15 @@ fn merge(models: &[tobj::Model], path: &Path) -> Result<Mesh> {
         }
         for t in m.indices.chunks_exact(3) {
             let shift = |i: u32| {
-                i.checked_add(offset).ok_or_else(|| {
-                    Error::TooLarge(format!("{}: too many vertices", path.display()))
-                })
+                i.checked_add(offset).ok_or_else(|| Error::TooLarge(format!("{}: too many vertices", path.display())))
             };
-            mesh.triangles
-                .push([shift(t[0])?, shift(t[1])?, shift(t[2])?]);
+            mesh.triangles.push([shift(t[0])?, shift(t[1])?, shift(t[2])?]);
         }
         let per_vertex = m.normals.len() == m.positions.len() && m.normal_indices == m.indices;
         match &mut mesh.normals {
-            Some(normals) if per_vertex => normals.extend(
-                m.normals
-                    .chunks_exact(3)
-                    .map(|n| Vec3::new(n[0], n[1], n[2])),
-            ),
+            Some(normals) if per_vertex => {
+                normals.extend(m.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])))
+            }
             _ => mesh.normals = None,
         }
     }
@@ -100,15 +92,12 @@ fn points(source: &str, path: &Path) -> Result<Mesh> {
         let at = |m: String| Error::parse(path, format!("line {n}"), m);
         let mut xyz = [0.0f32; 3];
         for c in &mut xyz {
-            let word = words
-                .next()
-                .ok_or_else(|| at("expected 3 numbers".into()))?;
+            let word = words.next().ok_or_else(|| at("expected 3 numbers".into()))?;
             *c = text::number(word).map_err(at)?;
         }
         if is_position {
             let vertex = positions.len();
-            let p = assemble::finite_position(Vec3::from(xyz))
-                .map_err(|m| at(format!("vertex {vertex} {m}")))?;
+            let p = assemble::finite_position(Vec3::from(xyz)).map_err(|m| at(format!("vertex {vertex} {m}")))?;
             positions.push(p);
         } else {
             normals.push(Vec3::from(xyz));
@@ -162,8 +151,7 @@ mod tests {
 
     #[test]
     fn merges_groups_with_offsets() {
-        let src =
-            "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
+        let src = "o a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no b\nv 0 0 1\nv 1 0 1\nv 0 1 1\nf 4 5 6\n";
         let m = parse_str(src).unwrap();
         assert_eq!(m.positions.len(), 6);
         assert_eq!(m.triangles, vec![[0, 1, 2], [3, 4, 5]]);

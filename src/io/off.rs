@@ -37,8 +37,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         counts_line = n;
     }
     let (vertex_count, face_count) = parse_counts(&counts).map_err(|m| at(counts_line, m))?;
-    assemble::vertex_count_fits(vertex_count)
-        .map_err(|m| Error::TooLarge(format!("{}: {m}", path.display())))?;
+    assemble::vertex_count_fits(vertex_count).map_err(|m| Error::TooLarge(format!("{}: {m}", path.display())))?;
 
     let mut positions = Vec::with_capacity(assemble::capacity(vertex_count, bytes.len(), 6));
     let mut normals = has_normals.then(|| Vec::with_capacity(positions.capacity()));
@@ -47,8 +46,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         let (n, line) = next(&|| format!("file ends in vertex {i} of {vertex_count}"))?;
         let values = numbers(&line, columns).map_err(|m| at(n, format!("vertex {i}: {m}")))?;
         let p = Vec3::new(values[0], values[1], values[2]);
-        positions
-            .push(assemble::finite_position(p).map_err(|m| at(n, format!("vertex {i}: {m}")))?);
+        positions.push(assemble::finite_position(p).map_err(|m| at(n, format!("vertex {i}: {m}")))?);
         if let Some(normals) = &mut normals {
             normals.push(Vec3::new(values[3], values[4], values[5]));
         }
@@ -62,11 +60,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
             .and_then(|()| assemble::push_fan(&polygon, &mut triangles))
             .map_err(|m| at(n, format!("face {i}: {m}")))?;
     }
-    Ok(Mesh {
-        positions,
-        normals,
-        triangles,
-    })
+    Ok(Mesh { positions, normals, triangles })
 }
 
 /// Lines with comments removed, skipping those left blank.
@@ -84,10 +78,7 @@ fn content_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, Cow<'_, str>)> {
 fn parse_keyword(keyword: &str) -> Result<bool, String> {
     match keyword.strip_suffix("OFF") {
         Some(prefix) if prefix.chars().all(|c| "STCN".contains(c)) => Ok(prefix.contains('N')),
-        _ => Err(format!(
-            "expected OFF, NOFF or COFF, found {}",
-            text::quoted(keyword)
-        )),
+        _ => Err(format!("expected OFF, NOFF or COFF, found {}", text::quoted(keyword))),
     }
 }
 
@@ -104,16 +95,9 @@ fn parse_counts(words: &[String]) -> Result<(usize, usize), String> {
 
 /// The first `columns` numbers of a line (the rest, e.g. a color, is ignored).
 fn numbers(line: &str, columns: usize) -> Result<Vec<f32>, String> {
-    let values = line
-        .split_whitespace()
-        .take(columns)
-        .map(text::number)
-        .collect::<Result<Vec<f32>, _>>()?;
+    let values = line.split_whitespace().take(columns).map(text::number).collect::<Result<Vec<f32>, _>>()?;
     if values.len() < columns {
-        return Err(format!(
-            "expected {columns} numbers, found {}",
-            values.len()
-        ));
+        return Err(format!("expected {columns} numbers, found {}", values.len()));
     }
     Ok(values)
 }
@@ -124,9 +108,7 @@ fn read_face(line: &str, vertex_count: usize, polygon: &mut Vec<u32>) -> Result<
     let mut words = line.split_whitespace();
     let n: usize = text::number(words.next().unwrap_or_default())?;
     for _ in 0..n {
-        let word = words
-            .next()
-            .ok_or_else(|| format!("announces {n} vertices but lists {}", polygon.len()))?;
+        let word = words.next().ok_or_else(|| format!("announces {n} vertices but lists {}", polygon.len()))?;
         polygon.push(assemble::vertex_index(text::number(word)?, vertex_count)?);
     }
     Ok(())
@@ -134,12 +116,7 @@ fn read_face(line: &str, vertex_count: usize, polygon: &mut Vec<u32>) -> Result<
 
 /// Writes `mesh` as plain OFF (normals are not part of plain OFF and are dropped).
 pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh) -> io::Result<()> {
-    writeln!(
-        out,
-        "OFF\n{} {} 0",
-        mesh.positions.len(),
-        mesh.triangles.len()
-    )?;
+    writeln!(out, "OFF\n{} {} 0", mesh.positions.len(), mesh.triangles.len())?;
     for p in &mesh.positions {
         writeln!(out, "{} {} {}", p.x, p.y, p.z)?;
     }
@@ -161,37 +138,20 @@ mod tests {
     fn reads_variants() {
         let m = parse_str("OFF 4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 255 0 0\n").unwrap();
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
-        let m =
-            parse_str("# c\nNOFF\n# c\n3 1\n0 0 0 0 0 1\n1 0 0 0 0 1 # x\n0 1 0 0 0 1\n3 0 1 2\n")
-                .unwrap();
+        let m = parse_str("# c\nNOFF\n# c\n3 1\n0 0 0 0 0 1\n1 0 0 0 0 1 # x\n0 1 0 0 0 1\n3 0 1 2\n").unwrap();
         assert_eq!(m.normals.unwrap()[2], Vec3::Z);
-        let m = parse_str(
-            "COFF\r\n3 1 3\r\n0 0 0 1 1 1 1\r\n1 0 0 1 1 1 1\r\n0 1 0 1 1 1 1\r\n3 0 1 2\r\n",
-        )
-        .unwrap();
+        let m = parse_str("COFF\r\n3 1 3\r\n0 0 0 1 1 1 1\r\n1 0 0 1 1 1 1\r\n0 1 0 1 1 1 1\r\n3 0 1 2\r\n").unwrap();
         assert_eq!(m.positions[1], Vec3::X);
         assert!(m.normals.is_none());
     }
 
     #[test]
     fn errors_name_the_line() {
-        let err = parse_str("OFF\n3 1 0\n0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            err.contains("line 4") && err.contains("vertex 1") && err.contains("`x`"),
-            "{err}"
-        );
-        let err = parse_str("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            err.contains("line 6") && err.contains("face 0") && err.contains("vertex 7"),
-            "{err}"
-        );
-        let err = parse_str("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
-            .unwrap_err()
-            .to_string();
+        let err = parse_str("OFF\n3 1 0\n0 0 0\n1 x 0\n0 1 0\n3 0 1 2\n").unwrap_err().to_string();
+        assert!(err.contains("line 4") && err.contains("vertex 1") && err.contains("`x`"), "{err}");
+        let err = parse_str("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n").unwrap_err().to_string();
+        assert!(err.contains("line 6") && err.contains("face 0") && err.contains("vertex 7"), "{err}");
+        let err = parse_str("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").unwrap_err().to_string();
         assert!(err.contains("file ends in face 1 of 2"), "{err}");
         let err = parse_str("PLY\n").unwrap_err().to_string();
         assert!(err.contains("expected OFF"), "{err}");

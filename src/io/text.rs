@@ -16,9 +16,7 @@ pub(crate) fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, Cow<'_, str>)>
 
 /// Parses one number token, with a message that shows the offending token.
 pub(crate) fn number<T: FromStr>(token: &str) -> Result<T, String> {
-    token
-        .parse()
-        .map_err(|_| format!("expected a number, found {}", quoted(token)))
+    token.parse().map_err(|_| format!("expected a number, found {}", quoted(token)))
 }
 
 /// `token` in backquotes, shortened if long, for error messages.

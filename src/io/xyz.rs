@@ -28,30 +28,20 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         }
         match first {
             None if values.len() == 3 || values.len() == 6 => first = Some((values.len(), n)),
-            None => {
-                return Err(at(format!(
-                    "expected 3 or 6 numbers (x y z [nx ny nz]), found {}",
-                    values.len()
-                )))
-            }
+            None => return Err(at(format!("expected 3 or 6 numbers (x y z [nx ny nz]), found {}", values.len()))),
             Some((columns, line)) if columns != values.len() => {
-                return Err(at(format!(
-                    "expected {columns} numbers like line {line}, found {}",
-                    values.len()
-                )))
+                return Err(at(format!("expected {columns} numbers like line {line}, found {}", values.len())))
             }
             Some(_) => {}
         }
         let p = Vec3::new(values[0], values[1], values[2]);
         let point = positions.len();
-        positions
-            .push(assemble::finite_position(p).map_err(|m| at(format!("point {point}: {m}")))?);
+        positions.push(assemble::finite_position(p).map_err(|m| at(format!("point {point}: {m}")))?);
         if let [_, _, _, nx, ny, nz] = values[..] {
             normals.push(Vec3::new(nx, ny, nz));
         }
     }
-    assemble::vertex_count_fits(positions.len())
-        .map_err(|m| Error::TooLarge(format!("{}: {m}", path.display())))?;
+    assemble::vertex_count_fits(positions.len()).map_err(|m| Error::TooLarge(format!("{}: {m}", path.display())))?;
     let has_normals = first.is_some_and(|(columns, _)| columns == 6);
     Ok(Mesh::from_points(positions, has_normals.then_some(normals)))
 }
@@ -90,10 +80,7 @@ mod tests {
     #[test]
     fn errors_name_the_line() {
         let err = parse_str("0 0 0 0 0 1\n\n1 1 1\n").unwrap_err().to_string();
-        assert!(
-            err.contains("line 3") && err.contains("like line 1"),
-            "{err}"
-        );
+        assert!(err.contains("line 3") && err.contains("like line 1"), "{err}");
         let err = parse_str("0 0 0 1\n").unwrap_err().to_string();
         assert!(err.contains("line 1") && err.contains("3 or 6"), "{err}");
         let err = parse_str("0 0 0\n0 zero 0\n").unwrap_err().to_string();

@@ -31,15 +31,9 @@ pub(crate) fn t_node_at(tree: &VsTree, p: Vec3) -> Option<u32> {
 /// A T-node for every vertex: the one whose cube holds it, or else (the vertex lies in an empty
 /// cell) the label of the nearest labelled vertex along the mesh's edges.
 pub(crate) fn label_vertices(tree: &VsTree, mesh: &Mesh) -> Vec<u32> {
-    let mut labels: Vec<u32> = mesh
-        .positions
-        .iter()
-        .map(|&p| t_node_at(tree, p).unwrap_or(UNLABELLED))
-        .collect();
+    let mut labels: Vec<u32> = mesh.positions.iter().map(|&p| t_node_at(tree, p).unwrap_or(UNLABELLED)).collect();
     let neighbours = vertex_neighbours(mesh);
-    let mut queue: VecDeque<u32> = (0..labels.len() as u32)
-        .filter(|&v| labels[v as usize] != UNLABELLED)
-        .collect();
+    let mut queue: VecDeque<u32> = (0..labels.len() as u32).filter(|&v| labels[v as usize] != UNLABELLED).collect();
     while let Some(v) = queue.pop_front() {
         for &w in &neighbours[v as usize] {
             if labels[w as usize] == UNLABELLED {
@@ -112,10 +106,7 @@ pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32]) -> BaseMesh {
     let mut c = Collapser::new(fine);
     let dropped = small_components(fine, labels);
     for (t, tri) in fine.triangles.iter().enumerate() {
-        if tri
-            .iter()
-            .any(|&v| labels[v as usize] == UNLABELLED || dropped[v as usize])
-        {
+        if tri.iter().any(|&v| labels[v as usize] == UNLABELLED || dropped[v as usize]) {
             c.alive_face[t] = false;
             for &v in tri {
                 c.alive_vertex[v as usize] = false;
@@ -198,10 +189,7 @@ impl Collapser {
             return false; // not an edge of a closed manifold (or no edge at all)
         }
         let (ring_u, ring_v) = (self.ring(u), self.ring(v));
-        let common = ring_u
-            .iter()
-            .filter(|w| ring_v.binary_search(w).is_ok())
-            .count();
+        let common = ring_u.iter().filter(|w| ring_v.binary_search(w).is_ok()).count();
         // Link condition; and never shrink a closed component below a tetrahedron.
         if common != 2 || ring_u.len() + ring_v.len() <= 6 {
             return false;
@@ -244,14 +232,7 @@ impl Collapser {
             .filter(|(_, &alive)| alive)
             .map(|(t, _)| t.map(|v| index[v as usize]))
             .collect();
-        BaseMesh {
-            mesh: Mesh {
-                positions,
-                normals: None,
-                triangles,
-            },
-            labels: out_labels,
-        }
+        BaseMesh { mesh: Mesh { positions, normals: None, triangles }, labels: out_labels }
     }
 }
 

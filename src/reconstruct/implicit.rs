@@ -52,12 +52,7 @@ impl<'t> PlaneBlend<'t> {
                 }
             }
         }
-        PlaneBlend {
-            tree,
-            reach_lo,
-            reach_hi,
-            radius_sq,
-        }
+        PlaneBlend { tree, reach_lo, reach_hi, radius_sq }
     }
 
     /// The signed distance of T-node `t`'s plane at `p` (positive on the normal's side).
@@ -105,17 +100,10 @@ mod tests {
     fn blended_planes_of_a_sphere_approximate_its_signed_distance() {
         let cloud = crate::shapes::sample_surface(&crate::shapes::icosphere(1.0, 5), 50_000, 1);
         let positions: Vec<Vec3> = cloud.positions.iter().map(|p| p.normalize()).collect();
-        let samples = SampleSet {
-            normals: positions.clone(),
-            origin: (0..50_000).collect(),
-            positions,
-        };
+        let samples = SampleSet { normals: positions.clone(), origin: (0..50_000).collect(), positions };
         let t = tree::build(
             &samples,
-            &TreeParams {
-                error: 1e-4,
-                ..Default::default()
-            },
+            &TreeParams { error: 1e-4, ..Default::default() },
             &Threads::new(0).unwrap(),
             &mut Progress::none(),
         )
@@ -125,10 +113,7 @@ mod tests {
         // surface by the patch's sag (about 0.05 here): the zero set sits that much inside.
         for p in [Vec3::X, Vec3::new(0.3, -0.5, 0.8).normalize(), -Vec3::Z] {
             assert!(f.eval(p).abs() < 0.08, "f({p}) = {}", f.eval(p));
-            assert!(
-                f.eval(p * 1.15) > 0.05 && f.eval(p * 0.85) < -0.05,
-                "no sign change across {p}"
-            );
+            assert!(f.eval(p * 1.15) > 0.05 && f.eval(p * 0.85) < -0.05, "no sign change across {p}");
         }
         assert!(f.eval(Vec3::splat(5.0)) > 0.0, "outside every support");
     }

@@ -1,5 +1,6 @@
 //! Surface reconstruction from a point cloud (paper §5, POINT_TO_MESH):
 //!
+//! 0. estimate normals where the cloud has none ([`crate::normals`]);
 //! 1. build the VS-Tree of the samples (the L2 bound is the de-noising control);
 //! 2. blend the T-nodes' planes into one implicit function ([`implicit`]), polygonise it on a
 //!    grid as fine as the deepest T-node ([`crate::polygonize`]), and cluster that mesh at the
@@ -21,6 +22,7 @@ pub use refine::LevelStats;
 use crate::distance::{PointBvh, TriangleBvh};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use crate::normals::{self, NormalParams, NormalsReport};
 use crate::polygonize::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
 use crate::progress::{Progress, Threads};
 use crate::samples::SampleSet;
@@ -37,6 +39,11 @@ pub const ERROR_SAMPLES: usize = 100_000;
 const SUPPORT_SCALE: f32 = 1.5;
 /// Beyond this many grid cells from every sample, the implicit function is pushed outside.
 const FAR_FROM_SAMPLES: f32 = 2.0;
+/// Beyond this many grid cells from every sample, a point is outside. Behind an open scan
+/// the planes would otherwise say "inside" as far as their supports reach; this closes such
+/// a surface into a thin slab (which trimming opens again). Inside a closed solid it only
+/// makes an inner shell that no sample's cell touches, so the tracker never finds it.
+const OUTSIDE_BEYOND: f32 = 4.0;
 /// The polygonisation gives up beyond this many grid cells along the surface.
 const MAX_GRID_CELLS: usize = 50_000_000;
 /// Fewer points than this cannot define a surface.
@@ -64,6 +71,10 @@ pub struct ReconstructParams {
     /// Remove faces farther than this many grid cells from every sample (open scans give
     /// open meshes); 0 keeps the closed surface.
     pub trim: f32,
+    /// Normals: estimated where the cloud has none (PCA over neighbours, oriented by spanning
+    /// tree propagation, turned outward); the cloud's own are kept unless
+    /// `normals.reorient_given`.
+    pub normals: NormalParams,
     /// Worker threads; 0 = all cores.
     pub threads: usize,
 }
@@ -71,16 +82,14 @@ pub struct ReconstructParams {
 impl Default for ReconstructParams {
     fn default() -> Self {
         ReconstructParams {
-            tree: TreeParams {
-                error: 5e-4,
-                ..TreeParams::default()
-            },
+            tree: TreeParams { error: 1e-5, ..TreeParams::default() },
             target_distance: 0.0,
             max_levels: 6,
             min_displaced: 0.02,
             max_triangles: 20_000_000,
             max_grid_depth: 10,
             trim: 0.0,
+            normals: NormalParams::default(),
             threads: 0,
         }
     }
@@ -91,34 +100,19 @@ impl ReconstructParams {
     pub fn check(&self) -> Result<()> {
         self.tree.check()?;
         if !(self.target_distance.is_finite() && self.target_distance >= 0.0) {
-            return Err(Error::param(
-                "target_distance",
-                format!("{}: must be >= 0", self.target_distance),
-            ));
+            return Err(Error::param("target_distance", format!("{}: must be >= 0", self.target_distance)));
         }
         if self.max_levels > 12 {
-            return Err(Error::param(
-                "max_levels",
-                format!("{}: must be in 0..=12", self.max_levels),
-            ));
+            return Err(Error::param("max_levels", format!("{}: must be in 0..=12", self.max_levels)));
         }
         if !(0.0..=1.0).contains(&self.min_displaced) {
-            return Err(Error::param(
-                "min_displaced",
-                format!("{}: must be in [0, 1]", self.min_displaced),
-            ));
+            return Err(Error::param("min_displaced", format!("{}: must be in [0, 1]", self.min_displaced)));
         }
         if self.max_triangles == 0 || self.max_triangles > u32::MAX as usize {
-            return Err(Error::param(
-                "max_triangles",
-                format!("{}: must be in 1..=2^32-1", self.max_triangles),
-            ));
+            return Err(Error::param("max_triangles", format!("{}: must be in 1..=2^32-1", self.max_triangles)));
         }
         if !(4..=20).contains(&self.max_grid_depth) {
-            return Err(Error::param(
-                "max_grid_depth",
-                format!("{}: must be in 4..=20", self.max_grid_depth),
-            ));
+            return Err(Error::param("max_grid_depth", format!("{}: must be in 4..=20", self.max_grid_depth)));
         }
         if !(self.trim.is_finite() && self.trim >= 0.0) {
             return Err(Error::param("trim", format!("{}: must be >= 0", self.trim)));
@@ -130,6 +124,8 @@ impl ReconstructParams {
 /// What [`reconstruct`] did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ReconstructStats {
+    /// What was done to the normals.
+    pub normals: NormalsReport,
     pub tree: TreeStats,
     /// Cells across the polygonisation grid (a power of two).
     pub grid_cells: u32,
@@ -147,6 +143,7 @@ pub struct ReconstructStats {
     pub trimmed_triangles: usize,
     pub output_vertices: usize,
     pub output_triangles: usize,
+    pub seconds_normals: f64,
     pub seconds_tree: f64,
     pub seconds_base: f64,
     pub seconds_refine: f64,
@@ -161,39 +158,55 @@ pub fn reconstruct(
 ) -> Result<(Mesh, ReconstructStats)> {
     params.check()?;
     if cloud.positions.len() < MIN_POINTS {
-        return Err(Error::input(format!(
-            "{} points: at least {MIN_POINTS} are needed",
-            cloud.positions.len()
-        )));
+        return Err(Error::input(format!("{} points: at least {MIN_POINTS} are needed", cloud.positions.len())));
     }
-    let samples = SampleSet::from_cloud(cloud)?;
     let threads = Threads::new(params.threads)?;
     let mut stats = ReconstructStats::default();
+    let start = Instant::now();
+    let mut oriented = Mesh::from_points(cloud.positions.clone(), cloud.normals.clone());
+    let normal_params = NormalParams { threads: params.threads, ..params.normals };
+    stats.normals = normals::ensure_normals(&mut oriented, &normal_params, &mut progress.stage(0.0, 0.15))?;
+    let samples = SampleSet::from_cloud(&oriented)?;
+    drop(oriented);
+    stats.seconds_normals = start.elapsed().as_secs_f64();
 
     let t0 = Instant::now();
-    let tree = tree::build(
-        &samples,
-        &params.tree,
-        &threads,
-        &mut progress.stage(0.0, 0.3),
-    )?;
+    let tree = tree::build(&samples, &params.tree, &threads, &mut progress.stage(0.15, 0.35))?;
     stats.tree = tree.stats();
     if stats.tree.t_nodes == 0 {
-        return Err(Error::input("no part of the cloud is a height field: no T-node, no surface (are the normals consistent?)"));
+        return Err(Error::input(
+            "no part of the cloud is a height field: no T-node, no surface (are the normals consistent?)",
+        ));
     }
     let t1 = Instant::now();
 
-    progress.report(0.3, "base mesh")?;
-    let grid = polygonisation_grid(&tree, params.max_grid_depth);
+    progress.report(0.35, "base mesh")?;
+    let near = threads.run(|| PointBvh::new(&samples.positions));
+    let spacing = sample_spacing(&samples.positions);
+    let grid = polygonisation_grid(&tree, params.max_grid_depth, spacing);
     stats.grid_cells = grid.dims[0] - 5;
     let seeds = sample_cells(&grid, &samples.positions, &threads);
     let blend = implicit::PlaneBlend::new(&tree, SUPPORT_SCALE, 1.5 * grid.cell);
-    let near = threads.run(|| PointBvh::new(&samples.positions));
-    let tolerance = FAR_FROM_SAMPLES * grid.cell;
-    let f = |p: Vec3| blend.eval(p) + (near.distance(p) - tolerance).max(0.0);
+    // Distances from the samples count in grid cells, or in sample spacings where the samples
+    // are sparser than the grid.
+    let unit = grid.cell.max(spacing);
+    // A T-node's plane strays from its samples by up to its patch's sag, so the cap on the
+    // distance to the samples must leave room for the typical T-node too.
+    let typical_t_half = median(tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| n.half).collect());
+    let tolerance = FAR_FROM_SAMPLES * unit;
+    let f = |p: Vec3| {
+        let d = near.distance(p);
+        if d > OUTSIDE_BEYOND * unit.max(typical_t_half) {
+            f32::MAX
+        } else {
+            blend.eval(p) + (d - tolerance).max(0.0)
+        }
+    };
     let fine = track_surface(&f, &grid, &seeds, MAX_GRID_CELLS, &threads)?;
     if fine.triangles.is_empty() {
-        return Err(Error::input("the blended T-node planes have no zero crossing near the samples (are the normals consistent?)"));
+        return Err(Error::input(
+            "the blended T-node planes have no zero crossing near the samples (are the normals consistent?)",
+        ));
     }
     stats.fine_triangles = fine.triangles.len();
     progress.report(0.4, "base mesh")?;
@@ -203,11 +216,7 @@ pub fn reconstruct(
     stats.base_triangles = base.mesh.triangles.len();
     stats.base_genus = topology::analyze(&base.mesh).genus();
     let mut surface = refine::Surface {
-        normals: base
-            .labels
-            .iter()
-            .map(|&t| tree.frames[tree.nodes[t as usize].frame as usize].normal)
-            .collect(),
+        normals: base.labels.iter().map(|&t| tree.frames[tree.nodes[t as usize].frame as usize].normal).collect(),
         positions: base.mesh.positions,
         labels: base.labels,
         triangles: base.mesh.triangles,
@@ -222,10 +231,7 @@ pub fn reconstruct(
         if rms <= params.target_distance || 4 * surface.triangles.len() > params.max_triangles {
             break;
         }
-        progress.report(
-            0.5 + 0.45 * level as f32 / params.max_levels as f32,
-            "refining",
-        )?;
+        progress.report(0.5 + 0.45 * level as f32 / params.max_levels as f32, "refining")?;
         let (refined, level_stats) = refiner.refine(&surface, &threads);
         surface = refined;
         stats.levels.push(level_stats);
@@ -238,18 +244,9 @@ pub fn reconstruct(
     let t3 = Instant::now();
 
     progress.report(0.95, "trimming")?;
-    let mut mesh = Mesh {
-        positions: surface.positions,
-        normals: Some(surface.normals),
-        triangles: surface.triangles,
-    };
+    let mut mesh = Mesh { positions: surface.positions, normals: Some(surface.normals), triangles: surface.triangles };
     if params.trim > 0.0 {
-        stats.trimmed_triangles = trim_far_faces(
-            &mut mesh,
-            &near,
-            params.trim * grid.cell,
-            &threads,
-        );
+        stats.trimmed_triangles = trim_far_faces(&mut mesh, &near, params.trim * grid.cell, &threads);
     }
     stats.seconds_trim = t3.elapsed().as_secs_f64();
     progress.report(1.0, "done")?;
@@ -261,26 +258,34 @@ pub fn reconstruct(
     Ok((mesh, stats))
 }
 
-/// The grid the base mesh is polygonised on: cells the size of the deepest T-node's cube
-/// (capped at 2^`max_depth` across the root), two cells of margin around the root cube.
-fn polygonisation_grid(tree: &VsTree, max_depth: u32) -> Grid {
-    let deepest = tree
-        .nodes
-        .iter()
-        .filter(|n| n.kind == NodeKind::Transition)
-        .map(|n| u32::from(n.depth))
-        .max()
-        .unwrap_or(0);
-    let depth = deepest.clamp(1, max_depth.min(MAX_GRID_POINTS_PER_AXIS.ilog2() - 1));
+/// The grid the base mesh is polygonised on: cells the size of the deepest T-node's cube, but
+/// no smaller than the samples' spacing (a finer grid sees nothing more) and at most
+/// 2^`max_depth` across the root; two cells of margin around the root cube.
+fn polygonisation_grid(tree: &VsTree, max_depth: u32, spacing: f32) -> Grid {
+    let deepest =
+        tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| u32::from(n.depth)).max().unwrap_or(0);
     let root = tree.root();
+    let resolvable = if spacing > 0.0 { (2.0 * root.half / spacing).log2().floor().max(1.0) as u32 } else { max_depth };
+    let depth = deepest.min(resolvable).clamp(1, max_depth.min(MAX_GRID_POINTS_PER_AXIS.ilog2() - 1));
     let cells = 1u32 << depth;
     let cell = 2.0 * root.half / cells as f32;
     let points = cells + 5;
-    Grid {
-        origin: root.center - root.half - 2.0 * cell,
-        cell,
-        dims: [points; 3],
-    }
+    Grid { origin: root.center - root.half - 2.0 * cell, cell, dims: [points; 3] }
+}
+
+/// The median of `values` (0 when empty).
+fn median(mut values: Vec<f32>) -> f32 {
+    values.sort_by(f32::total_cmp);
+    values.get(values.len() / 2).copied().unwrap_or(0.0)
+}
+
+/// The typical distance between neighbouring samples: the median, over up to 2,000 of the odd
+/// samples, of the distance to the nearest even sample.
+fn sample_spacing(points: &[Vec3]) -> f32 {
+    let even: Vec<Vec3> = points.iter().step_by(2).copied().collect();
+    let bvh = PointBvh::new(&even);
+    let odd: Vec<Vec3> = points.iter().skip(1).step_by(2).copied().collect();
+    median(evenly_spread(&odd, 2000).iter().map(|&p| bvh.distance(p)).filter(|d| d.is_finite()).collect())
 }
 
 /// The grid cells that hold samples: where the surface tracking starts.
@@ -300,17 +305,8 @@ fn evenly_spread(points: &[Vec3], n: usize) -> Vec<Vec3> {
 }
 
 /// error(M, S): RMS and max distance from `points` to the surface, over `diagonal`.
-fn sample_error(
-    s: &refine::Surface,
-    points: &[Vec3],
-    diagonal: f32,
-    threads: &Threads,
-) -> (f64, f64) {
-    let mesh = Mesh {
-        positions: s.positions.clone(),
-        normals: None,
-        triangles: s.triangles.clone(),
-    };
+fn sample_error(s: &refine::Surface, points: &[Vec3], diagonal: f32, threads: &Threads) -> (f64, f64) {
+    let mesh = Mesh { positions: s.positions.clone(), normals: None, triangles: s.triangles.clone() };
     let (sum_sq, max) = threads.run(|| {
         let bvh = TriangleBvh::new(&mesh);
         points

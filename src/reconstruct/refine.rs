@@ -75,16 +75,8 @@ impl<'t> Refiner<'t> {
             normal.push(n);
             variation.push(v);
         }
-        let locked = (0..tree.nodes.len())
-            .map(|_| AtomicBool::new(false))
-            .collect();
-        Refiner {
-            tree,
-            average,
-            normal,
-            variation,
-            locked,
-        }
+        let locked = (0..tree.nodes.len()).map(|_| AtomicBool::new(false)).collect();
+        Refiner { tree, average, normal, variation, locked }
     }
 
     /// Splits every triangle of `s` 1-to-4 and places the new vertices.
@@ -97,25 +89,18 @@ impl<'t> Refiner<'t> {
         let mut edges: Vec<(u32, u32)> = s
             .triangles
             .par_iter()
-            .flat_map_iter(|t| {
-                (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
-            })
+            .flat_map_iter(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
             .collect();
         edges.par_sort_unstable();
         edges.dedup();
-        let mid =
-            |a: u32, b: u32| old + edges.binary_search(&(a.min(b), a.max(b))).unwrap_or(0) as u32;
+        let mid = |a: u32, b: u32| old + edges.binary_search(&(a.min(b), a.max(b))).unwrap_or(0) as u32;
 
         // New vertices on the PN triangles' edge curves, with PN's quadratic normals.
         let placed: Vec<(Vec3, Vec3, u32)> = edges
             .par_iter()
             .map(|&(a, b)| {
-                let (pa, pb, na, nb) = (
-                    s.positions[a as usize],
-                    s.positions[b as usize],
-                    s.normals[a as usize],
-                    s.normals[b as usize],
-                );
+                let (pa, pb, na, nb) =
+                    (s.positions[a as usize], s.positions[b as usize], s.normals[a as usize], s.normals[b as usize]);
                 let (p, n) = pn_midpoint(pa, na, pb, nb);
                 let label = t_node_at(self.tree, p).unwrap_or(s.labels[a as usize]);
                 (p, n, label)
@@ -141,21 +126,16 @@ impl<'t> Refiner<'t> {
         }
 
         // Displacement, one T-node's quadtree per task.
-        let mut by_t_node: Vec<(u32, u32)> = placed
-            .iter()
-            .enumerate()
-            .map(|(k, &(_, _, l))| (l, old + k as u32))
-            .collect();
+        let mut by_t_node: Vec<(u32, u32)> =
+            placed.iter().enumerate().map(|(k, &(_, _, l))| (l, old + k as u32)).collect();
         by_t_node.par_sort_unstable();
         let groups: Vec<&[(u32, u32)]> = by_t_node.chunk_by(|a, b| a.0 == b.0).collect();
         let moves: Vec<(u32, u32)> = groups
             .par_iter()
             .flat_map_iter(|group| {
                 let t = group[0].0 as usize;
-                let vertices: Vec<(u32, Vec2)> = group
-                    .iter()
-                    .map(|&(_, v)| (v, self.uv(t, out.positions[v as usize])))
-                    .collect();
+                let vertices: Vec<(u32, Vec2)> =
+                    group.iter().map(|&(_, v)| (v, self.uv(t, out.positions[v as usize]))).collect();
                 let mut moves = Vec::new();
                 self.displace(t, vertices, &mut moves);
                 moves
@@ -171,13 +151,7 @@ impl<'t> Refiner<'t> {
         }
 
         smooth_tangentially(&mut out, old, &displaced);
-        (
-            out,
-            LevelStats {
-                new_vertices: placed.len(),
-                displaced: moves.len(),
-            },
-        )
+        (out, LevelStats { new_vertices: placed.len(), displaced: moves.len() })
     }
 
     /// Coordinates of `p` in the plane of T-node `t`.
@@ -195,10 +169,8 @@ impl<'t> Refiner<'t> {
         } else {
             (node.center_uv(), node.half)
         };
-        let inside: Vec<(u32, Vec2)> = vertices
-            .into_iter()
-            .filter(|(_, uv)| (*uv - center).abs().max_element() <= half)
-            .collect();
+        let inside: Vec<(u32, Vec2)> =
+            vertices.into_iter().filter(|(_, uv)| (*uv - center).abs().max_element() <= half).collect();
         match inside.len() {
             0 => {}
             1 => {
@@ -213,9 +185,7 @@ impl<'t> Refiner<'t> {
                     let mine: Vec<(u32, Vec2)> = inside
                         .iter()
                         .copied()
-                        .filter(|(_, uv)| {
-                            ((uv.x >= center.x) as u8 | ((uv.y >= center.y) as u8) << 1) == slot
-                        })
+                        .filter(|(_, uv)| ((uv.x >= center.x) as u8 | ((uv.y >= center.y) as u8) << 1) == slot)
                         .collect();
                     if !mine.is_empty() {
                         self.displace(child, mine, moves);
@@ -271,11 +241,7 @@ pub(crate) fn pn_midpoint(pa: Vec3, na: Vec3, pb: Vec3, nb: Vec3) -> (Vec3, Vec3
     let p = (pa + 3.0 * b1 + 3.0 * b2 + pb) / 8.0;
     // Quadratic normal: the average, reflected across the plane normal to the edge.
     let len2 = e.length_squared();
-    let v = if len2 > 0.0 {
-        2.0 * e.dot(na + nb) / len2
-    } else {
-        0.0
-    };
+    let v = if len2 > 0.0 { 2.0 * e.dot(na + nb) / len2 } else { 0.0 };
     let n110 = (na + nb - v * e).normalize_or_zero();
     let n = (0.25 * (na + nb) + 0.5 * n110).normalize_or_zero();
     (p, if n == Vec3::ZERO { na } else { n })
@@ -318,11 +284,7 @@ mod tests {
         let (p, n) = pn_midpoint(a, a, b, b);
         let chord = 0.5 * (a + b);
         assert!(p.length() > chord.length() + 0.2, "no bulge: {p}");
-        assert!(
-            (p.length() - 1.0).abs() < 0.02,
-            "{p} is off the circle by {}",
-            p.length() - 1.0
-        );
+        assert!((p.length() - 1.0).abs() < 0.02, "{p} is off the circle by {}", p.length() - 1.0);
         assert!((n - Vec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-5);
         // Flat: the midpoint of the chord.
         let (p, _) = pn_midpoint(Vec3::ZERO, Vec3::Z, Vec3::X, Vec3::Z);

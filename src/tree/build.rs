@@ -10,10 +10,7 @@
 
 use super::indicator::{frame, is_height_field};
 use super::partition::partition;
-use super::{
-    representative, Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree,
-    NO_FRAME,
-};
+use super::{representative, Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
 use crate::error::{Error, Result};
 use crate::mesh::Aabb;
 use crate::progress::{Progress, Threads};
@@ -31,12 +28,7 @@ const STATS_CHUNK: usize = 1 << 15;
 type Pending = (usize, CellStats);
 
 /// Builds the tree `params` describes over `samples`.
-pub fn build(
-    samples: &SampleSet,
-    params: &TreeParams,
-    threads: &Threads,
-    progress: &mut Progress,
-) -> Result<VsTree> {
+pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progress: &mut Progress) -> Result<VsTree> {
     params.check()?;
     check_samples(samples)?;
     progress.report(0.0, "building tree")?;
@@ -57,11 +49,7 @@ pub fn build(
         (samples.positions.par_iter(), samples.normals.par_iter())
             .into_par_iter()
             .enumerate()
-            .map(|(i, (&position, &normal))| TreeSample {
-                position,
-                normal,
-                index: i as u32,
-            })
+            .map(|(i, (&position, &normal))| TreeSample { position, normal, index: i as u32 })
             .collect()
     });
     let root = Node {
@@ -78,10 +66,7 @@ pub fn build(
         slot: 0,
     };
     let root_stats = threads.run(|| {
-        let sums: Vec<CellStats> = work
-            .par_chunks(STATS_CHUNK)
-            .map(|c| sum(c, builder.origin))
-            .collect();
+        let sums: Vec<CellStats> = work.par_chunks(STATS_CHUNK).map(|c| sum(c, builder.origin)).collect();
         sums.iter().fold(CellStats::default(), |mut total, s| {
             total.merge(s);
             total
@@ -89,27 +74,15 @@ pub fn build(
     });
 
     // Phase 1: the large nodes, on this thread.
-    let mut part = Part {
-        nodes: vec![root],
-        frames: Vec::new(),
-        shared_frames: &[],
-        samples: &mut work,
-        sample_base: 0,
-    };
+    let mut part =
+        Part { nodes: vec![root], frames: Vec::new(), shared_frames: &[], samples: &mut work, sample_base: 0 };
     let mut pending = builder.grow(&mut part, (0, root_stats), Some(threads));
-    let Part {
-        mut nodes,
-        mut frames,
-        ..
-    } = part;
+    let Part { mut nodes, mut frames, .. } = part;
     progress.report(0.2, "building tree")?;
 
     // Phase 2: the subtrees below them, in parallel, in batches so progress can be reported.
     pending.sort_by_key(|&(i, _)| nodes[i].start);
-    let jobs = carve(
-        &mut work,
-        pending.iter().map(|&(i, stats)| (i, nodes[i], stats)),
-    );
+    let jobs = carve(&mut work, pending.iter().map(|&(i, stats)| (i, nodes[i], stats)));
     let total = samples.len().max(1) as f32;
     let mut done = 0usize;
     let mut results = Vec::with_capacity(jobs.len());
@@ -144,22 +117,9 @@ pub fn build(
 
     let shared_len = frames.len() as u32;
     for (i, local_nodes, local_frames) in results {
-        append_part(
-            &mut nodes,
-            &mut frames,
-            i,
-            local_nodes,
-            local_frames,
-            shared_len,
-        );
+        append_part(&mut nodes, &mut frames, i, local_nodes, local_frames, shared_len);
     }
-    Ok(VsTree {
-        nodes,
-        frames,
-        samples: work,
-        diagonal,
-        params: *params,
-    })
+    Ok(VsTree { nodes, frames, samples: work, diagonal, params: *params })
 }
 
 fn check_samples(samples: &SampleSet) -> Result<()> {
@@ -167,28 +127,16 @@ fn check_samples(samples: &SampleSet) -> Result<()> {
         return Err(Error::input("no samples"));
     }
     if samples.normals.len() != samples.len() {
-        return Err(Error::input(format!(
-            "{} normals for {} samples",
-            samples.normals.len(),
-            samples.len()
-        )));
+        return Err(Error::input(format!("{} normals for {} samples", samples.normals.len(), samples.len())));
     }
     if samples.len() >= u32::MAX as usize {
-        return Err(Error::TooLarge(format!(
-            "{} samples (at most {})",
-            samples.len(),
-            u32::MAX - 1
-        )));
+        return Err(Error::TooLarge(format!("{} samples (at most {})", samples.len(), u32::MAX - 1)));
     }
     if let Some(i) = samples.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::input(format!(
-            "sample {i} has a NaN or infinite coordinate"
-        )));
+        return Err(Error::input(format!("sample {i} has a NaN or infinite coordinate")));
     }
     if let Some(i) = samples.normals.iter().position(|n| !n.is_finite()) {
-        return Err(Error::input(format!(
-            "sample {i} has a NaN or infinite normal"
-        )));
+        return Err(Error::input(format!("sample {i} has a NaN or infinite normal")));
     }
     Ok(())
 }
@@ -257,13 +205,7 @@ impl Builder {
 
     /// Decides what node `i` (whose samples sum to `stats`) is: a leaf, a T-node, or split; and
     /// creates its children, returned with their sums.
-    fn process(
-        &self,
-        part: &mut Part,
-        i: usize,
-        stats: &CellStats,
-        threads: Option<&Threads>,
-    ) -> Vec<Pending> {
+    fn process(&self, part: &mut Part, i: usize, stats: &CellStats, threads: Option<&Threads>) -> Vec<Pending> {
         let node = part.nodes[i];
         let small_enough = match self.params.metric {
             Metric::L2 => {
@@ -274,9 +216,7 @@ impl Builder {
             Metric::L21 => stats.normal_deviation() <= self.params.error,
             Metric::Density => stats.count as f64 <= self.params.error,
         };
-        let splittable = node.count > 1
-            && u32::from(node.depth) < self.params.max_depth
-            && node.half > self.min_half;
+        let splittable = node.count > 1 && u32::from(node.depth) < self.params.max_depth && node.half > self.min_half;
         let split = !small_enough && splittable;
 
         match node.kind {
@@ -284,13 +224,7 @@ impl Builder {
                 let slice = part.slice(&node);
                 let centroid = (stats.centroid() + self.origin).as_vec3();
                 let flat = self.params.kind == TreeKind::VsTree
-                    && is_height_field(
-                        slice,
-                        centroid,
-                        stats.mean_normal(),
-                        self.params.d_a,
-                        self.params.d_d,
-                    );
+                    && is_height_field(slice, centroid, stats.mean_normal(), self.params.d_a, self.params.d_d);
                 if flat {
                     let f = frame(slice, stats, self.origin);
                     let index = (part.shared_frames.len() + part.frames.len()) as u32;
@@ -306,9 +240,7 @@ impl Builder {
                     return self.split_octants(part, i, threads);
                 }
             }
-            NodeKind::Surface if split => {
-                return self.split_quadrants(part, i, node.center, node.half, threads)
-            }
+            NodeKind::Surface if split => return self.split_quadrants(part, i, node.center, node.half, threads),
             _ => {}
         }
         Vec::new()
@@ -404,10 +336,7 @@ fn add_children(
 }
 
 /// Splits `samples` into the disjoint ranges of the given nodes (sorted by start).
-fn carve(
-    samples: &mut [TreeSample],
-    nodes: impl Iterator<Item = (usize, Node, CellStats)>,
-) -> Vec<Job<'_>> {
+fn carve(samples: &mut [TreeSample], nodes: impl Iterator<Item = (usize, Node, CellStats)>) -> Vec<Job<'_>> {
     let mut rest = samples;
     let mut consumed = 0usize;
     let mut jobs = Vec::new();
@@ -417,12 +346,7 @@ fn carve(
         let (mine, tail) = tail.split_at_mut(node.count as usize);
         rest = tail;
         consumed = node.start as usize + node.count as usize;
-        jobs.push(Job {
-            index,
-            node,
-            stats,
-            samples: mine,
-        });
+        jobs.push(Job { index, node, stats, samples: mine });
     }
     jobs
 }

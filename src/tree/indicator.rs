@@ -9,13 +9,7 @@ use glam::{DVec3, Vec2, Vec3};
 /// centroid `c` with normal n̄ (the normalised average normal):
 /// every nⱼ·n̄ > d_a (normal cone), and max |(pⱼ − c)·n̄| < d_d · max ‖pₖ − c‖ (displacement).
 /// Samples with a zero normal carry no orientation and are left out of the cone test.
-pub(super) fn is_height_field(
-    samples: &[TreeSample],
-    centroid: Vec3,
-    mean_normal: DVec3,
-    d_a: f32,
-    d_d: f32,
-) -> bool {
+pub(super) fn is_height_field(samples: &[TreeSample], centroid: Vec3, mean_normal: DVec3, d_a: f32, d_d: f32) -> bool {
     if mean_normal.length() < 1e-6 {
         return false; // normals cancel out: no plane to project on
     }
@@ -44,16 +38,8 @@ pub(super) fn frame(samples: &[TreeSample], stats: &CellStats, origin: DVec3) ->
     let (_, vectors) = stats.normal_covariance().eigen();
     // The eigenvector most aligned with n is dropped; of the other two, the one with the larger
     // eigenvalue (the eigenvectors come sorted by decreasing eigenvalue) becomes u.
-    let most_aligned = (0..3).max_by(|&a, &b| {
-        vectors[a]
-            .dot(normal)
-            .abs()
-            .total_cmp(&vectors[b].dot(normal).abs())
-    });
-    let candidate = (0..3)
-        .find(|&i| Some(i) != most_aligned)
-        .map(|i| vectors[i])
-        .unwrap_or(DVec3::X);
+    let most_aligned = (0..3).max_by(|&a, &b| vectors[a].dot(normal).abs().total_cmp(&vectors[b].dot(normal).abs()));
+    let candidate = (0..3).find(|&i| Some(i) != most_aligned).map(|i| vectors[i]).unwrap_or(DVec3::X);
     let mut u = candidate - normal * candidate.dot(normal);
     if u.length() < 1e-6 {
         u = normal.any_orthonormal_vector();
@@ -77,8 +63,7 @@ pub(super) fn frame(samples: &[TreeSample], stats: &CellStats, origin: DVec3) ->
     frame.square_center = 0.5 * (lo + hi);
     // Slightly enlarged so samples on the border are inside; never zero.
     let half = 0.5 * (hi - lo).max_element();
-    frame.square_half =
-        half * (1.0 + 1e-4) + 1e-7 * (1.0 + frame.square_center.abs().max_element());
+    frame.square_half = half * (1.0 + 1e-4) + 1e-7 * (1.0 + frame.square_center.abs().max_element());
     frame
 }
 
@@ -87,11 +72,7 @@ mod tests {
     use super::*;
 
     fn sample(p: Vec3, n: Vec3) -> TreeSample {
-        TreeSample {
-            position: p,
-            normal: n.normalize(),
-            index: 0,
-        }
+        TreeSample { position: p, normal: n.normalize(), index: 0 }
     }
 
     fn stats_of(samples: &[TreeSample]) -> CellStats {
@@ -104,50 +85,22 @@ mod tests {
 
     #[test]
     fn flat_patch_is_a_height_field_and_a_fold_is_not() {
-        let flat: Vec<_> = (0..25)
-            .map(|i| sample(Vec3::new((i % 5) as f32, (i / 5) as f32, 0.0), Vec3::Z))
-            .collect();
+        let flat: Vec<_> = (0..25).map(|i| sample(Vec3::new((i % 5) as f32, (i / 5) as f32, 0.0), Vec3::Z)).collect();
         let st = stats_of(&flat);
-        assert!(is_height_field(
-            &flat,
-            st.centroid().as_vec3(),
-            st.mean_normal(),
-            0.0,
-            1.0 / 6.0
-        ));
+        assert!(is_height_field(&flat, st.centroid().as_vec3(), st.mean_normal(), 0.0, 1.0 / 6.0));
         let mut folded = flat.clone();
         folded.push(sample(Vec3::new(2.0, 2.0, 0.1), -Vec3::Z));
         let st = stats_of(&folded);
-        assert!(!is_height_field(
-            &folded,
-            st.centroid().as_vec3(),
-            st.mean_normal(),
-            0.0,
-            1.0 / 6.0
-        ));
+        assert!(!is_height_field(&folded, st.centroid().as_vec3(), st.mean_normal(), 0.0, 1.0 / 6.0));
     }
 
     #[test]
     fn displacement_test_rejects_a_tall_spike() {
-        let mut s: Vec<_> = (0..25)
-            .map(|i| sample(Vec3::new((i % 5) as f32, (i / 5) as f32, 0.0), Vec3::Z))
-            .collect();
+        let mut s: Vec<_> = (0..25).map(|i| sample(Vec3::new((i % 5) as f32, (i / 5) as f32, 0.0), Vec3::Z)).collect();
         s.push(sample(Vec3::new(2.0, 2.0, 1.5), Vec3::Z));
         let st = stats_of(&s);
-        assert!(!is_height_field(
-            &s,
-            st.centroid().as_vec3(),
-            st.mean_normal(),
-            0.0,
-            1.0 / 6.0
-        ));
-        assert!(is_height_field(
-            &s,
-            st.centroid().as_vec3(),
-            st.mean_normal(),
-            0.0,
-            1.0
-        ));
+        assert!(!is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), 0.0, 1.0 / 6.0));
+        assert!(is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), 0.0, 1.0));
     }
 
     #[test]

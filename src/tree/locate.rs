@@ -25,11 +25,7 @@ impl VsTree {
                 }
                 NodeKind::Transition | NodeKind::Surface => {
                     let f = &self.frames[node.frame as usize];
-                    let c = if node.kind == NodeKind::Transition {
-                        f.square_center
-                    } else {
-                        node.center_uv()
-                    };
+                    let c = if node.kind == NodeKind::Transition { f.square_center } else { node.center_uv() };
                     let q = f.project(p);
                     (q.x >= c.x) as u8 | ((q.y >= c.y) as u8) << 1
                 }

@@ -83,42 +83,24 @@ impl TreeParams {
         let positive = self.error.is_finite() && self.error > 0.0;
         match self.metric {
             Metric::Density if !(positive && self.error >= 1.0) => {
-                return Err(Error::param(
-                    "error",
-                    format!("{} samples per cell: must be at least 1", self.error),
-                ))
+                return Err(Error::param("error", format!("{} samples per cell: must be at least 1", self.error)))
             }
             _ if !positive => {
-                return Err(Error::param(
-                    "error",
-                    format!("{}: must be a finite number > 0", self.error),
-                ))
+                return Err(Error::param("error", format!("{}: must be a finite number > 0", self.error)))
             }
             _ => {}
         }
         if !(0.0..=1.0).contains(&self.d_a) {
-            return Err(Error::param(
-                "d_a",
-                format!("{}: must be in [0, 1]", self.d_a),
-            ));
+            return Err(Error::param("d_a", format!("{}: must be in [0, 1]", self.d_a)));
         }
         if !(0.0..=1.0).contains(&self.d_d) {
-            return Err(Error::param(
-                "d_d",
-                format!("{}: must be in [0, 1]", self.d_d),
-            ));
+            return Err(Error::param("d_d", format!("{}: must be in [0, 1]", self.d_d)));
         }
         if !(1..=MAX_DEPTH).contains(&self.max_depth) {
-            return Err(Error::param(
-                "max_depth",
-                format!("{}: must be in 1..={MAX_DEPTH}", self.max_depth),
-            ));
+            return Err(Error::param("max_depth", format!("{}: must be in 1..={MAX_DEPTH}", self.max_depth)));
         }
         if !(self.min_cell_size.is_finite() && (0.0..1.0).contains(&self.min_cell_size)) {
-            return Err(Error::param(
-                "min_cell_size",
-                format!("{}: must be in [0, 1)", self.min_cell_size),
-            ));
+            return Err(Error::param("min_cell_size", format!("{}: must be in [0, 1)", self.min_cell_size)));
         }
         Ok(())
     }
@@ -163,26 +145,13 @@ pub struct Node {
 /// T-nodes, and for S-nodes (`frame` given) the prism over its square. The tree's L2 test and
 /// the simplification's output vertex both use this point, so the bound holds for the vertex.
 /// Returned in absolute coordinates.
-pub fn representative(
-    node: &Node,
-    frame: Option<&Frame>,
-    stats: &CellStats,
-    origin: DVec3,
-) -> DVec3 {
+pub fn representative(node: &Node, frame: Option<&Frame>, stats: &CellStats, origin: DVec3) -> DVec3 {
     let x = stats.quadric_minimizer() + origin;
     match (node.kind, frame) {
         (NodeKind::Surface, Some(f)) => {
-            let (o, u, v, n) = (
-                f.origin.as_dvec3(),
-                f.u.as_dvec3(),
-                f.v.as_dvec3(),
-                f.normal.as_dvec3(),
-            );
+            let (o, u, v, n) = (f.origin.as_dvec3(), f.u.as_dvec3(), f.v.as_dvec3(), f.normal.as_dvec3());
             let d = x - o;
-            let (lo, hi) = (
-                (node.center_uv() - node.half).as_dvec2(),
-                (node.center_uv() + node.half).as_dvec2(),
-            );
+            let (lo, hi) = ((node.center_uv() - node.half).as_dvec2(), (node.center_uv() + node.half).as_dvec2());
             o + u * d.dot(u).clamp(lo.x, hi.x) + v * d.dot(v).clamp(lo.y, hi.y) + n * d.dot(n)
         }
         _ => {
@@ -291,11 +260,7 @@ impl VsTree {
 
     /// Indices of the leaves, in node order: leaf `k` of this iterator is cluster `k`.
     pub fn leaves(&self) -> impl Iterator<Item = usize> + '_ {
-        self.nodes
-            .iter()
-            .enumerate()
-            .filter(|(_, n)| n.is_leaf())
-            .map(|(i, _)| i)
+        self.nodes.iter().enumerate().filter(|(_, n)| n.is_leaf()).map(|(i, _)| i)
     }
 
     pub fn samples_of(&self, node: &Node) -> &[TreeSample] {
@@ -303,11 +268,7 @@ impl VsTree {
     }
 
     pub fn stats(&self) -> TreeStats {
-        let mut s = TreeStats {
-            samples: self.samples.len(),
-            nodes: self.nodes.len(),
-            ..Default::default()
-        };
+        let mut s = TreeStats { samples: self.samples.len(), nodes: self.nodes.len(), ..Default::default() };
         let (mut t_min, mut t_max) = (u32::MAX, 0);
         let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
         for node in &self.nodes {

@@ -21,9 +21,7 @@ pub(super) fn partition<const B: usize>(
     threads: Option<&Threads>,
 ) -> [CellStats; B] {
     match threads {
-        Some(t) if samples.len() >= PARALLEL_MIN => {
-            t.run(|| partition_parallel(samples, key, origin))
-        }
+        Some(t) if samples.len() >= PARALLEL_MIN => t.run(|| partition_parallel(samples, key, origin)),
         _ => partition_in_place(samples, key, origin),
     }
 }
@@ -75,8 +73,7 @@ fn partition_parallel<const B: usize>(
             for &k in &keys {
                 counts[k as usize] += 1;
             }
-            let mut lists: [Vec<TreeSample>; B] =
-                std::array::from_fn(|b| Vec::with_capacity(counts[b]));
+            let mut lists: [Vec<TreeSample>; B] = std::array::from_fn(|b| Vec::with_capacity(counts[b]));
             let mut stats = [CellStats::default(); B];
             for (s, &k) in chunk.iter().zip(&keys) {
                 stats[k as usize].add(s.position.as_dvec3() - origin, s.normal.as_dvec3());
@@ -100,9 +97,7 @@ fn partition_parallel<const B: usize>(
             copies.push((dst, &lists[b]));
         }
     }
-    copies
-        .into_par_iter()
-        .for_each(|(dst, src)| dst.copy_from_slice(src));
+    copies.into_par_iter().for_each(|(dst, src)| dst.copy_from_slice(src));
     stats
 }
 
@@ -116,11 +111,7 @@ mod tests {
             .map(|i| {
                 let x = ((i * 7919) % 1000) as f32 / 1000.0;
                 let y = ((i * 104729) % 997) as f32 / 997.0;
-                TreeSample {
-                    position: Vec3::new(x, y, 0.5),
-                    normal: Vec3::Z,
-                    index: i as u32,
-                }
+                TreeSample { position: Vec3::new(x, y, 0.5), normal: Vec3::Z, index: i as u32 }
             })
             .collect()
     }
@@ -142,16 +133,10 @@ mod tests {
         }
         for v in [&a, &b] {
             let keys: Vec<usize> = v.iter().map(key).collect();
-            assert!(
-                keys.windows(2).all(|w| w[0] <= w[1]),
-                "not grouped by bucket"
-            );
+            assert!(keys.windows(2).all(|w| w[0] <= w[1]), "not grouped by bucket");
             let mut idx: Vec<u32> = v.iter().map(|s| s.index).collect();
             idx.sort_unstable();
-            assert!(
-                idx.iter().enumerate().all(|(i, &j)| i as u32 == j),
-                "not a permutation"
-            );
+            assert!(idx.iter().enumerate().all(|(i, &j)| i as u32 == j), "not a permutation");
         }
         assert_eq!(sa.iter().map(|s| s.count).sum::<u64>(), n as u64);
     }

@@ -15,10 +15,7 @@ impl VsTree {
         }
         let root = &self.nodes[0];
         if root.start != 0 || root.count as usize != n || root.kind == NodeKind::Surface {
-            return Err(format!(
-                "root covers {}..+{} of {n} samples, kind {:?}",
-                root.start, root.count, root.kind
-            ));
+            return Err(format!("root covers {}..+{} of {n} samples, kind {:?}", root.start, root.count, root.kind));
         }
         let mut seen = vec![false; n];
         for s in &self.samples {
@@ -29,8 +26,7 @@ impl VsTree {
         }
         let mut covered = vec![0u8; n];
         for (i, node) in self.nodes.iter().enumerate() {
-            self.check_node(i)
-                .map_err(|e| format!("node {i} ({:?}, depth {}): {e}", node.kind, node.depth))?;
+            self.check_node(i).map_err(|e| format!("node {i} ({:?}, depth {}): {e}", node.kind, node.depth))?;
             if node.is_leaf() {
                 for c in &mut covered[node.range()] {
                     *c += 1;
@@ -41,9 +37,7 @@ impl VsTree {
             return Err(format!("sample {i} is in {} leaves", covered[i]));
         }
         for (i, f) in self.frames.iter().enumerate() {
-            let ok = [f.normal, f.u, f.v]
-                .iter()
-                .all(|a| (a.length() - 1.0).abs() < 1e-4)
+            let ok = [f.normal, f.u, f.v].iter().all(|a| (a.length() - 1.0).abs() < 1e-4)
                 && f.normal.dot(f.u).abs() < 1e-4
                 && f.normal.dot(f.v).abs() < 1e-4
                 && f.u.dot(f.v).abs() < 1e-4
@@ -73,24 +67,20 @@ impl VsTree {
                 .position(|s| ((s.position - node.center).abs() - node.half).max_element() > tol),
             NodeKind::Surface => {
                 let f = &self.frames[node.frame as usize];
-                self.samples_of(node).iter().position(|s| {
-                    ((f.project(s.position) - node.center_uv()).abs() - node.half).max_element()
-                        > tol
-                })
+                self.samples_of(node)
+                    .iter()
+                    .position(|s| ((f.project(s.position) - node.center_uv()).abs() - node.half).max_element() > tol)
             }
         };
         if let Some(k) = outside {
-            return Err(format!(
-                "sample {} lies outside the cell",
-                node.start as usize + k
-            ));
+            return Err(format!("sample {} lies outside the cell", node.start as usize + k));
         }
         if node.kind == NodeKind::Transition {
             let f = &self.frames[node.frame as usize];
-            let outside = self.samples_of(node).iter().any(|s| {
-                ((f.project(s.position) - f.square_center).abs() - f.square_half).max_element()
-                    > tol
-            });
+            let outside = self
+                .samples_of(node)
+                .iter()
+                .any(|s| ((f.project(s.position) - f.square_center).abs() - f.square_half).max_element() > tol);
             if outside {
                 return Err("a sample projects outside the T-node's square".into());
             }
@@ -119,34 +109,21 @@ impl VsTree {
                 }
             };
             if !kind_ok {
-                return Err(format!(
-                    "a {:?} node has a {:?} child",
-                    node.kind, child.kind
-                ));
+                return Err(format!("a {:?} node has a {:?} child", node.kind, child.kind));
             }
-            let half_ok = (child.half - 0.5 * node.half).abs() <= 1e-5 * node.half
-                || node.kind == NodeKind::Transition;
+            let half_ok = (child.half - 0.5 * node.half).abs() <= 1e-5 * node.half || node.kind == NodeKind::Transition;
             let inside = match (node.kind, child.kind) {
                 (NodeKind::Volume, _) => {
-                    ((child.center - node.center).abs() + child.half - node.half).max_element()
-                        <= tol
+                    ((child.center - node.center).abs() + child.half - node.half).max_element() <= tol
                 }
                 (NodeKind::Transition, _) => {
                     let f = &self.frames[node.frame as usize];
-                    ((child.center_uv() - f.square_center).abs() + child.half - f.square_half)
-                        .max_element()
-                        <= tol
+                    ((child.center_uv() - f.square_center).abs() + child.half - f.square_half).max_element() <= tol
                 }
-                _ => {
-                    ((child.center_uv() - node.center_uv()).abs() + child.half - node.half)
-                        .max_element()
-                        <= tol
-                }
+                _ => ((child.center_uv() - node.center_uv()).abs() + child.half - node.half).max_element() <= tol,
             };
             if !half_ok || !inside {
-                return Err(format!(
-                    "child {c}'s cell is not a sub-cell of its parent's"
-                ));
+                return Err(format!("child {c}'s cell is not a sub-cell of its parent's"));
             }
         }
         if next != node.start + node.count {

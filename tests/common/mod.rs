@@ -33,10 +33,7 @@ pub fn all_models() -> Vec<(String, Mesh)> {
         .filter(|n| vstree::io::Format::from_path(n.as_ref()).is_some())
         .collect();
     names.sort();
-    names
-        .into_iter()
-        .map(|n| (n.clone(), load(&n).unwrap()))
-        .collect()
+    names.into_iter().map(|n| (n.clone(), load(&n).unwrap())).collect()
 }
 
 /// The samples the library would use: mesh vertices, or the cloud's points when it has normals.

@@ -10,19 +10,8 @@ use crate::mesh::Mesh;
 use std::path::Path;
 
 /// Reads the body `bytes`, which starts on line `first_line`.
-pub(crate) fn read(
-    bytes: &[u8],
-    first_line: usize,
-    header: &Header,
-    plan: &Plan,
-    path: &Path,
-) -> Result<Mesh> {
-    let mut tokens = Tokens {
-        bytes,
-        pos: 0,
-        line: first_line,
-        token_line: first_line,
-    };
+pub(crate) fn read(bytes: &[u8], first_line: usize, header: &Header, plan: &Plan, path: &Path) -> Result<Mesh> {
+    let mut tokens = Tokens { bytes, pos: 0, line: first_line, token_line: first_line };
     let mut parts = Parts::new(plan.vertex_count, plan.has_normals);
     for (element, job) in header.elements.iter().zip(&plan.jobs) {
         items::read_element(&mut tokens, element, job, &mut parts, path)?;
@@ -52,11 +41,7 @@ impl<'a> Tokens<'a> {
             self.pos += 1;
         }
         let start = self.pos;
-        while self
-            .bytes
-            .get(self.pos)
-            .is_some_and(|b| !b.is_ascii_whitespace())
-        {
+        while self.bytes.get(self.pos).is_some_and(|b| !b.is_ascii_whitespace()) {
             self.pos += 1;
         }
         let token = self.bytes.get(start..self.pos).filter(|t| !t.is_empty())?;

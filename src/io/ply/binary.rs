@@ -11,18 +11,8 @@ use crate::mesh::Mesh;
 use std::path::Path;
 
 /// Reads the body `bytes` in the given byte order.
-pub(crate) fn read(
-    bytes: &[u8],
-    big_endian: bool,
-    header: &Header,
-    plan: &Plan,
-    path: &Path,
-) -> Result<Mesh> {
-    let mut cursor = Bytes {
-        data: bytes,
-        pos: 0,
-        big_endian,
-    };
+pub(crate) fn read(bytes: &[u8], big_endian: bool, header: &Header, plan: &Plan, path: &Path) -> Result<Mesh> {
+    let mut cursor = Bytes { data: bytes, pos: 0, big_endian };
     let mut parts = Parts::new(plan.vertex_count, plan.has_normals);
     for (element, job) in header.elements.iter().zip(&plan.jobs) {
         match fixed_layout(element, job) {
@@ -54,29 +44,16 @@ fn fixed_layout(element: &Element, job: &Job) -> Option<Layout> {
         }
         stride = stride.checked_add(ty.size())?;
     }
-    Some(Layout {
-        stride,
-        fields,
-        vertices: job.target == Target::Vertices,
-    })
+    Some(Layout { stride, fields, vertices: job.target == Target::Vertices })
 }
 
 /// Decodes (or skips) all items of a fixed-size element in one pass over its bytes.
-fn read_fixed(
-    cursor: &mut Bytes,
-    element: &Element,
-    layout: &Layout,
-    parts: &mut Parts,
-    path: &Path,
-) -> Result<()> {
+fn read_fixed(cursor: &mut Bytes, element: &Element, layout: &Layout, parts: &mut Parts, path: &Path) -> Result<()> {
     if layout.stride == 0 {
         return Ok(());
     }
     let available = cursor.remaining();
-    let block = element
-        .count
-        .checked_mul(layout.stride)
-        .and_then(|size| cursor.take(size));
+    let block = element.count.checked_mul(layout.stride).and_then(|size| cursor.take(size));
     let Some(block) = block else {
         let item = available / layout.stride;
         return Err(items::error(path, None, element, item, Fail::End));
@@ -89,10 +66,7 @@ fn read_fixed(
     for (item, bytes) in block.chunks_exact(layout.stride).enumerate() {
         let mut decoded = Ok(());
         for &(offset, ty, slot) in &layout.fields {
-            match bytes
-                .get(offset..)
-                .and_then(|b| ty.decode(b, cursor.big_endian))
-            {
+            match bytes.get(offset..).and_then(|b| ty.decode(b, cursor.big_endian)) {
                 Some(value) => coords[slot] = value as f32,
                 None => decoded = Err(Fail::End),
             }

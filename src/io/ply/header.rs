@@ -70,10 +70,7 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Header> {
             [] | ["comment", ..] | ["obj_info", ..] => {}
             ["format", format, version] => {
                 if *version != "1.0" && *version != "1" {
-                    return Err(fail(format!(
-                        "unsupported PLY version {}",
-                        text::quoted(version)
-                    )));
+                    return Err(fail(format!("unsupported PLY version {}", text::quoted(version))));
                 }
                 encoding = Some(match *format {
                     "ascii" => Encoding::Ascii,
@@ -83,79 +80,40 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Header> {
                 });
             }
             ["element", name, count] => {
-                let count = count.parse().map_err(|_| {
-                    fail(format!(
-                        "element count {} is not a number",
-                        text::quoted(count)
-                    ))
-                })?;
-                elements.push(Element {
-                    name: name.to_string(),
-                    count,
-                    properties: Vec::new(),
-                    line: number,
-                });
+                let count = count
+                    .parse()
+                    .map_err(|_| fail(format!("element count {} is not a number", text::quoted(count))))?;
+                elements.push(Element { name: name.to_string(), count, properties: Vec::new(), line: number });
             }
             ["property", rest @ ..] => {
-                let element = elements
-                    .last_mut()
-                    .ok_or_else(|| fail("property before any element".into()))?;
+                let element = elements.last_mut().ok_or_else(|| fail("property before any element".into()))?;
                 element.properties.push(property(rest).map_err(fail)?);
             }
             ["end_header"] => {
-                let encoding =
-                    encoding.ok_or_else(|| fail("no `format` line before end_header".into()))?;
-                return Ok(Header {
-                    encoding,
-                    elements,
-                    body_start: offset,
-                    lines: number,
-                });
+                let encoding = encoding.ok_or_else(|| fail("no `format` line before end_header".into()))?;
+                return Ok(Header { encoding, elements, body_start: offset, lines: number });
             }
-            _ => {
-                return Err(fail(format!(
-                    "unexpected header line {}",
-                    text::quoted(&line)
-                )))
-            }
+            _ => return Err(fail(format!("unexpected header line {}", text::quoted(&line)))),
         }
     }
-    Err(Error::parse(
-        path,
-        "header",
-        "file ends before `end_header`",
-    ))
+    Err(Error::parse(path, "header", "file ends before `end_header`"))
 }
 
 /// Length of the first line of `bytes` including its `\n`.
 fn line_length(bytes: &[u8]) -> usize {
-    bytes
-        .iter()
-        .position(|&b| b == b'\n')
-        .map_or(bytes.len(), |i| i + 1)
+    bytes.iter().position(|&b| b == b'\n').map_or(bytes.len(), |i| i + 1)
 }
 
 /// Parses the words after `property`.
 fn property(words: &[&str]) -> Result<Property, String> {
-    let scalar = |name: &str| {
-        Scalar::from_name(name)
-            .ok_or_else(|| format!("unknown property type {}", text::quoted(name)))
-    };
+    let scalar =
+        |name: &str| Scalar::from_name(name).ok_or_else(|| format!("unknown property type {}", text::quoted(name)));
     let (kind, name) = match words {
-        ["list", count, item, name] => (
-            Kind::List {
-                count: scalar(count)?,
-                item: scalar(item)?,
-            },
-            name,
-        ),
+        ["list", count, item, name] => (Kind::List { count: scalar(count)?, item: scalar(item)? }, name),
         [ty, name] if *ty != "list" => (Kind::Scalar(scalar(ty)?), name),
         _ => return Err("malformed property line".into()),
     };
-    Ok(Property {
-        name: name.to_string(),
-        kind,
-    })
+    Ok(Property { name: name.to_string(), kind })
 }
 
 #[cfg(test)]
@@ -175,30 +133,18 @@ mod tests {
         assert_eq!(h.encoding, Encoding::BinaryBigEndian);
         assert_eq!(h.elements.len(), 2);
         assert_eq!(h.elements[1].line, 7);
-        assert_eq!(
-            h.elements[1].properties[0].kind,
-            Kind::List {
-                count: Scalar::Uint8,
-                item: Scalar::Int32
-            }
-        );
+        assert_eq!(h.elements[1].properties[0].kind, Kind::List { count: Scalar::Uint8, item: Scalar::Int32 });
         assert_eq!(&src.as_bytes()[h.body_start..], b"BODY");
         assert_eq!(h.lines, 9);
     }
 
     #[test]
     fn reports_the_bad_line() {
-        let err = parse_str("ply\nformat ascii 1.0\nelement v 1\nproperty quux x\nend_header\n")
-            .unwrap_err()
-            .to_string();
+        let err =
+            parse_str("ply\nformat ascii 1.0\nelement v 1\nproperty quux x\nend_header\n").unwrap_err().to_string();
         assert!(err.contains("line 4") && err.contains("`quux`"), "{err}");
-        let err = parse_str("ply\nformat weird 1.0\nend_header\n")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            err.contains("line 2") && err.contains("unknown format"),
-            "{err}"
-        );
+        let err = parse_str("ply\nformat weird 1.0\nend_header\n").unwrap_err().to_string();
+        assert!(err.contains("line 2") && err.contains("unknown format"), "{err}");
         for bad in ["plx\n", "plyx\n", "ply 1\n"] {
             let err = parse_str(bad).unwrap_err().to_string();
             assert!(err.contains("line 1: not a PLY file"), "{err}");

@@ -50,12 +50,7 @@ pub(crate) struct Parts {
 impl Parts {
     /// Empty parts for a file with `vertex_count` vertices.
     pub(crate) fn new(vertex_count: usize, has_normals: bool) -> Parts {
-        Parts {
-            positions: Vec::new(),
-            normals: has_normals.then(Vec::new),
-            triangles: Vec::new(),
-            vertex_count,
-        }
+        Parts { positions: Vec::new(), normals: has_normals.then(Vec::new), triangles: Vec::new(), vertex_count }
     }
 
     /// Reserves room for `n` more vertices.
@@ -79,11 +74,7 @@ impl Parts {
 
     /// The finished mesh.
     pub(crate) fn into_mesh(self) -> Mesh {
-        Mesh {
-            positions: self.positions,
-            normals: self.normals,
-            triangles: self.triangles,
-        }
+        Mesh { positions: self.positions, normals: self.normals, triangles: self.triangles }
     }
 }
 
@@ -105,13 +96,7 @@ fn index(value: f64, vertex_count: usize) -> Result<u32, Fail> {
 }
 
 /// The error for item `item` of `element`: located by line for text, by item for binary.
-pub(crate) fn error(
-    path: &Path,
-    line: Option<usize>,
-    element: &Element,
-    item: usize,
-    fail: Fail,
-) -> Error {
+pub(crate) fn error(path: &Path, line: Option<usize>, element: &Element, item: usize, fail: Fail) -> Error {
     let subject = format!("{} {item}", element.name);
     match (fail, line) {
         (Fail::End, line) => Error::parse(
@@ -119,9 +104,7 @@ pub(crate) fn error(
             line.map_or(subject.clone(), |n| format!("line {n}")),
             format!("file ends in {subject} of {}", element.count),
         ),
-        (Fail::Bad(message), Some(n)) => {
-            Error::parse(path, format!("line {n}"), format!("{subject}: {message}"))
-        }
+        (Fail::Bad(message), Some(n)) => Error::parse(path, format!("line {n}"), format!("{subject}: {message}")),
         (Fail::Bad(message), None) => Error::parse(path, subject, message),
     }
 }
@@ -147,20 +130,13 @@ pub(crate) fn read_element<C: Cursor>(
     let mut coords = [0.0f32; 6];
     let mut polygon = Vec::new();
     for item in 0..element.count {
-        read_item(
-            cursor,
-            element,
-            job,
-            parts.vertex_count,
-            &mut coords,
-            &mut polygon,
-        )
-        .and_then(|()| match job.target {
-            Target::Vertices => parts.push_vertex(coords).map_err(Fail::Bad),
-            Target::Faces => assemble::push_fan(&polygon, &mut parts.triangles).map_err(Fail::Bad),
-            Target::Nothing => Ok(()),
-        })
-        .map_err(|fail| error(path, cursor.line(), element, item, fail))?;
+        read_item(cursor, element, job, parts.vertex_count, &mut coords, &mut polygon)
+            .and_then(|()| match job.target {
+                Target::Vertices => parts.push_vertex(coords).map_err(Fail::Bad),
+                Target::Faces => assemble::push_fan(&polygon, &mut parts.triangles).map_err(Fail::Bad),
+                Target::Nothing => Ok(()),
+            })
+            .map_err(|fail| error(path, cursor.line(), element, item, fail))?;
     }
     Ok(())
 }

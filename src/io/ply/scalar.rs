@@ -74,10 +74,7 @@ mod tests {
     fn decodes_both_endiannesses() {
         assert_eq!(Scalar::Int16.decode(&[0xff, 0xfe], false), Some(-257.0));
         assert_eq!(Scalar::Int16.decode(&[0xfe, 0xff], true), Some(-257.0));
-        assert_eq!(
-            Scalar::Uint32.decode(&[0, 0, 0, 0x80], false),
-            Some(2147483648.0)
-        );
+        assert_eq!(Scalar::Uint32.decode(&[0, 0, 0, 0x80], false), Some(2147483648.0));
         let bytes = 1.5f32.to_be_bytes();
         assert_eq!(Scalar::Float32.decode(&bytes, true), Some(1.5));
         assert_eq!(Scalar::Float64.decode(&[0; 7], false), None);

@@ -9,12 +9,7 @@ use std::io::{self, Write};
 pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh, ascii: bool) -> io::Result<()> {
     write_header(out, mesh, ascii)?;
     let normals = mesh.normals.as_deref();
-    let normal = |i: usize| {
-        normals
-            .and_then(|n| n.get(i))
-            .copied()
-            .unwrap_or(Vec3::ZERO)
-    };
+    let normal = |i: usize| normals.and_then(|n| n.get(i)).copied().unwrap_or(Vec3::ZERO);
     if ascii {
         for (i, p) in mesh.positions.iter().enumerate() {
             write!(out, "{} {} {}", p.x, p.y, p.z)?;
@@ -46,27 +41,16 @@ pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh, ascii: bool) -> io::Resu
 }
 
 fn write_header<W: Write>(out: &mut W, mesh: &Mesh, ascii: bool) -> io::Result<()> {
-    let format = if ascii {
-        "ascii"
-    } else {
-        "binary_little_endian"
-    };
+    let format = if ascii { "ascii" } else { "binary_little_endian" };
     writeln!(out, "ply\nformat {format} 1.0\ncomment written by vstree")?;
     writeln!(out, "element vertex {}", mesh.positions.len())?;
     writeln!(out, "property float x\nproperty float y\nproperty float z")?;
     if mesh.normals.is_some() {
-        writeln!(
-            out,
-            "property float nx\nproperty float ny\nproperty float nz"
-        )?;
+        writeln!(out, "property float nx\nproperty float ny\nproperty float nz")?;
     }
     if !mesh.triangles.is_empty() {
         // `int` is what most readers expect; indices past its range need `uint`.
-        let index_type = if i32::try_from(mesh.positions.len()).is_ok() {
-            "int"
-        } else {
-            "uint"
-        };
+        let index_type = if i32::try_from(mesh.positions.len()).is_ok() { "int" } else { "uint" };
         writeln!(out, "element face {}", mesh.triangles.len())?;
         writeln!(out, "property list uchar {index_type} vertex_indices")?;
     }
