@@ -138,10 +138,20 @@ thread_local! {
     static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
 }
 
-fn set_last_error(message: &str) {
+/// Replaces this thread's message. `try_with`/`try_borrow_mut`: during thread teardown (a host
+/// calling from a thread-local destructor) or re-entrantly, the message is skipped instead of
+/// panicking outside the guard.
+fn set_last_error(message: CString) {
+    let _ = LAST_ERROR.try_with(|slot| {
+        if let Ok(mut slot) = slot.try_borrow_mut() {
+            *slot = message;
+        }
+    });
+}
+
+fn store_message(message: &str) {
     // Messages can quote file content; a NUL byte would cut the C string short.
-    let clean = CString::new(message.replace('\0', "\\0")).unwrap_or_default();
-    LAST_ERROR.with(|slot| *slot.borrow_mut() = clean);
+    set_last_error(CString::new(message.replace('\0', "\\0")).unwrap_or_default());
 }
 
 /// The text of a caught panic's payload.
@@ -174,7 +184,7 @@ fn catch<T>(work: impl FnOnce() -> T) -> Result<T, String> {
 /// error, runs `body` with panics caught, and turns its outcome into a status, storing the
 /// message (prefixed with `function`) on failure.
 pub(crate) fn guard(function: &str, body: impl FnOnce() -> FfiResult) -> vstree_status {
-    LAST_ERROR.with(|slot| *slot.borrow_mut() = CString::default());
+    set_last_error(CString::default());
     let failure = match catch(body) {
         Ok(Ok(())) => return vstree_status::Ok,
         Ok(Err(failure)) => failure,
@@ -183,7 +193,7 @@ pub(crate) fn guard(function: &str, body: impl FnOnce() -> FfiResult) -> vstree_
             format!("internal error (a bug in vstree, please report it): {panic}"),
         ),
     };
-    set_last_error(&format!("{function}: {}", failure.message));
+    store_message(&format!("{function}: {}", failure.message));
     failure.status
 }
 
@@ -240,7 +250,9 @@ pub extern "C" fn vstree_status_str(status: i32) -> *const c_char {
 #[no_mangle]
 pub extern "C" fn vstree_last_error_message() -> *const c_char {
     guard_or(c"".as_ptr(), || {
-        LAST_ERROR.with(|slot| slot.borrow().as_ptr())
+        LAST_ERROR
+            .try_with(|slot| slot.try_borrow().map_or(c"".as_ptr(), |m| m.as_ptr()))
+            .unwrap_or(c"".as_ptr())
     })
 }
 
@@ -252,8 +264,10 @@ pub extern "C" fn vstree_last_error_message() -> *const c_char {
 #[no_mangle]
 pub unsafe extern "C" fn vstree_last_error_copy(buffer: *mut c_char, capacity: usize) -> usize {
     guard_or(0, || {
-        LAST_ERROR.with(|slot| {
-            let message = slot.borrow();
+        let copy = |slot: &RefCell<CString>| {
+            let Ok(message) = slot.try_borrow() else {
+                return 0;
+            };
             let bytes = message.as_bytes();
             if !buffer.is_null() && capacity > 0 {
                 let mut n = bytes.len().min(capacity - 1);
@@ -267,7 +281,8 @@ pub unsafe extern "C" fn vstree_last_error_copy(buffer: *mut c_char, capacity: u
                 }
             }
             bytes.len()
-        })
+        };
+        LAST_ERROR.try_with(copy).unwrap_or(0)
     })
 }
 
