@@ -4,11 +4,11 @@
 # committed seeds (fuzz/seeds, made by fuzz/make_seeds.py). Any crash, sanitizer report,
 # panic, or VSTREE_STATUS_INTERNAL from the C API fails the run; the input is kept under
 # target/fuzz-artifacts/<target>/ for reproduction:
-#   RUSTC_BOOTSTRAP=1 cargo fuzz run --fuzz-dir fuzz <target> <artifact>
+#   RUSTC_BOOTSTRAP=1 cargo fuzz run --fuzz-dir fuzz --target-dir target/fuzz <target> <artifact>
 #
 # cargo-fuzz needs nightly compiler flags (-Zsanitizer, coverage passes); the stable
 # toolchain accepts them with RUSTC_BOOTSTRAP=1, which is set for these builds only.
-# Usage: tests/fuzz.sh [SECONDS_PER_TARGET]   (default 15; the C API targets get twice that)
+# Usage: fuzz/run.sh [SECONDS_PER_TARGET]   (default 15; the C API targets get twice that)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -16,7 +16,7 @@ CARGO_FUZZ_VERSION=0.13.2
 seconds=${1:-15}
 
 if ! cargo fuzz --version 2>/dev/null | grep -q " $CARGO_FUZZ_VERSION\$"; then
-    echo "tests/fuzz.sh: installing cargo-fuzz $CARGO_FUZZ_VERSION"
+    echo "fuzz/run.sh: installing cargo-fuzz $CARGO_FUZZ_VERSION"
     cargo install cargo-fuzz --locked --version "$CARGO_FUZZ_VERSION"
 fi
 
@@ -40,7 +40,7 @@ for target in ply obj off xyz capi_load capi_arrays; do
         -max_total_time="$time" -max_len=4096 -rss_limit_mb=2048 -timeout=10 \
         -artifact_prefix="$artifacts" -print_final_stats=1 >"$log" 2>&1; then
         tail -n 60 "$log" >&2
-        echo "tests/fuzz.sh: $target failed; the input is in $artifacts" >&2
+        echo "fuzz/run.sh: $target failed; the input is in $artifacts" >&2
         exit 1
     fi
     grep -E '^stat::number_of_executed_units|^Done' "$log" | tr '\n' ' '
