@@ -11,8 +11,9 @@ use vstree::ffi::vstree_status;
 
 mod tolerate_tobj;
 
-const NAMES: [&std::ffi::CStr; 8] =
-    [c"f.ply", c"f.obj", c"f.off", c"f.xyz", c"f.pwn", c"ply", c"x.stl", c""];
+const NAMES: [&std::ffi::CStr; 8] = [
+    c"f.ply", c"f.obj", c"f.off", c"f.xyz", c"f.pwn", c"ply", c"x.stl", c"",
+];
 
 fn ok(status: vstree_status) -> bool {
     assert_ne!(status, vstree_status::Internal, "a panic was caught: a bug");

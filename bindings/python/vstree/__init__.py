@@ -147,7 +147,10 @@ class Mesh:
             lib.vstree_mesh_free(handle)
 
     def __del__(self):
-        self.close()
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may already be unloaded
+            pass
 
     def __enter__(self):
         return self
@@ -348,7 +351,10 @@ class Tree:
             lib.vstree_tree_free(handle)
 
     def __del__(self):
-        self.close()
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may already be unloaded
+            pass
 
     def __enter__(self):
         return self
