@@ -39,9 +39,18 @@ pub(crate) fn into_handle(mesh: Mesh) -> *mut vstree_mesh {
     Box::into_raw(Box::new(vstree_mesh { mesh }))
 }
 
-fn triples(flat: &[f32], what: &str) -> FfiResult<Vec<Vec3>> {
-    let mut out = arrays::with_capacity(flat.len() / 3, what)?;
-    out.extend(flat.chunks_exact(3).map(Vec3::from_slice));
+/// Copies a flat array of `3 × n` values into `n` triples in one `memcpy`.
+fn triples<T: Copy, U: Copy>(flat: &[T], what: &str) -> FfiResult<Vec<U>> {
+    const {
+        assert!(std::mem::size_of::<U>() == 3 * std::mem::size_of::<T>());
+        assert!(std::mem::align_of::<U>() == std::mem::align_of::<T>());
+    }
+    let n = flat.len() / 3;
+    // SAFETY: U is three packed T with T's alignment (checked above at compile time), and
+    // `flat` holds at least 3 × n elements.
+    let as_triples = unsafe { std::slice::from_raw_parts(flat.as_ptr().cast::<U>(), n) };
+    let mut out = arrays::with_capacity(n, what)?;
+    out.extend_from_slice(as_triples);
     Ok(out)
 }
 
@@ -87,13 +96,13 @@ pub unsafe extern "C" fn vstree_mesh_create(
             true => None,
             false => Some(unsafe { input(normals, floats, "normals") }?),
         };
-        let flat = unsafe { input(triangles, indices, "triangles") }?;
-        let mut tris = arrays::with_capacity(triangle_count, "triangles")?;
-        tris.extend(flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]));
+        let triangles = unsafe { input(triangles, indices, "triangles") }?;
         let mesh = Mesh {
-            positions: triples(positions, "positions")?,
-            normals: normals.map(|n| triples(n, "normals")).transpose()?,
-            triangles: tris,
+            positions: triples::<f32, Vec3>(positions, "positions")?,
+            normals: normals
+                .map(|n| triples::<f32, Vec3>(n, "normals"))
+                .transpose()?,
+            triangles: triples::<u32, [u32; 3]>(triangles, "triangles")?,
         };
         mesh.check()?;
         unsafe { write_out(out_mesh, into_handle(mesh)) };

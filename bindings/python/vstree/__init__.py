@@ -228,7 +228,10 @@ def _as_indices(triangles):
         return np.zeros((0, 3), np.uint32)
     if t.dtype.kind not in "ui":
         raise TypeError("triangles must be integers, not %s" % t.dtype)
-    if t.min() < 0 or t.max() > 0xFFFFFFFF:
+    # Indices of a type wider than uint32, or signed, might not fit: check before converting
+    # (the library checks each index against the vertex count anyway).
+    fits = t.dtype.kind == "u" and t.dtype.itemsize <= 4
+    if not fits and (t.min() < 0 or t.max() > 0xFFFFFFFF):
         raise ValueError("triangle indices must be in [0, 2^32 - 1]")
     return _as_rows(t, np.uint32, "triangles")
 
