@@ -7,6 +7,7 @@
 
 pub mod distance;
 pub mod error;
+pub mod ffi;
 pub mod io;
 pub mod knn;
 mod linalg;

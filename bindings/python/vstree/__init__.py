@@ -1,0 +1,402 @@
+"""vstree for Python: Volume-Surface Trees (Boubekeur et al. 2006) for clustering simplification,
+through the library's C API with numpy arrays in and out.
+
+    import numpy as np, vstree
+    mesh = vstree.Mesh(positions, triangles)          # (n, 3) floats, (m, 3) ints
+    result = vstree.simplify(mesh, error=2e-3, progress=lambda f, stage: print(f, stage))
+    result.mesh.positions, result.mesh.triangles       # numpy arrays
+    result.stats["clusters"], result.stats["seconds_total"]
+    tree = vstree.Tree(mesh)                          # the structure, for viewers
+    tree.vertex_labels("cluster")                     # colour the mesh by cluster
+
+Failures raise :class:`VstreeError` with the C status and the library's message. Depends on
+numpy and the standard library only (Blender's Python has both). The calls release the GIL,
+so threads can simplify different meshes at once.
+"""
+
+import ctypes
+import os
+from collections import namedtuple
+
+import numpy as np
+
+from . import _ffi
+from ._ffi import lib
+
+__all__ = [
+    "ABI_VERSION",
+    "Mesh",
+    "Tree",
+    "SimplifyResult",
+    "VstreeError",
+    "CancelledError",
+    "simplify",
+    "load",
+    "version",
+    "library_path",
+    "Status",
+]
+
+ABI_VERSION = _ffi.ABI_VERSION
+version = _ffi.version
+library_path = _ffi.library_path
+
+
+class Status:
+    """The C API's status numbers (vstree_status)."""
+
+    OK = 0
+    NULL_POINTER = 1
+    INVALID_ARGUMENT = 2
+    INVALID_PARAMETER = 3
+    INVALID_INPUT = 4
+    TOO_LARGE = 5
+    OUT_OF_MEMORY = 6
+    IO = 7
+    PARSE = 8
+    UNSUPPORTED_FORMAT = 9
+    CANCELLED = 10
+    BUFFER_TOO_SMALL = 11
+    INTERNAL = 12
+
+
+class VstreeError(Exception):
+    """A failed vstree call. ``status`` is the C status number (see :class:`Status`),
+    ``message`` the library's detail (function, parameter or argument, file and line...)."""
+
+    def __init__(self, status, message):
+        self.status = status
+        self.message = message
+        name = lib.vstree_status_str(status).decode()
+        super().__init__("%s [status %d: %s]" % (message, status, name))
+
+
+class CancelledError(VstreeError):
+    """The progress callback asked to stop (status CANCELLED)."""
+
+
+def _check(status):
+    if status != Status.OK:
+        message = lib.vstree_last_error_message().decode("utf-8", "replace")
+        cls = CancelledError if status == Status.CANCELLED else VstreeError
+        raise cls(status, message)
+
+
+def _path(path):
+    return os.fsencode(path)
+
+
+class Mesh:
+    """A triangle mesh, or a point cloud when it has no triangles; immutable.
+
+    ``positions``: (n, 3) array-like of floats; ``triangles``: (m, 3) array-like of vertex
+    indices (None or empty for a point cloud); ``normals``: None or (n, 3) floats. The arrays
+    are copied into the library.
+    """
+
+    __slots__ = ("_handle",)
+
+    def __init__(self, positions, triangles=None, normals=None):
+        p = _as_rows(positions, np.float32, "positions")
+        n = None if normals is None else _as_rows(normals, np.float32, "normals")
+        if n is not None and n.shape != p.shape:
+            raise ValueError("normals has shape %s, positions %s" % (n.shape, p.shape))
+        t = np.zeros((0, 3), np.uint32) if triangles is None else _as_indices(triangles)
+        handle = ctypes.c_void_p()
+        _check(
+            lib.vstree_mesh_create(
+                p.ctypes.data_as(_ffi._F32P),
+                p.shape[0],
+                None if n is None else n.ctypes.data_as(_ffi._F32P),
+                t.ctypes.data_as(_ffi._U32P),
+                t.shape[0],
+                ctypes.byref(handle),
+            )
+        )
+        self._handle = handle.value
+
+    @classmethod
+    def _wrap(cls, handle):
+        mesh = cls.__new__(cls)
+        mesh._handle = handle
+        return mesh
+
+    @classmethod
+    def load(cls, path):
+        """Reads .ply, .obj, .off, .xyz or .pwn (the extension gives the format)."""
+        handle = ctypes.c_void_p()
+        _check(lib.vstree_mesh_load(_path(path), ctypes.byref(handle)))
+        return cls._wrap(handle.value)
+
+    @classmethod
+    def from_bytes(cls, data, name):
+        """Parses a whole file held in memory; ``name`` ("scan.ply" or "ply") gives the format."""
+        data = bytes(data)
+        handle = ctypes.c_void_p()
+        _check(lib.vstree_mesh_load_memory(data, len(data), name.encode(), ctypes.byref(handle)))
+        return cls._wrap(handle.value)
+
+    def save(self, path, ascii=False):
+        """Writes the mesh (format from the extension; atomic: on error the file is unchanged)."""
+        _check(lib.vstree_mesh_save(self._handle, _path(path), 1 if ascii else 0))
+
+    def close(self):
+        """Frees the mesh now (it is freed when garbage-collected otherwise)."""
+        handle, self._handle = getattr(self, "_handle", None), None
+        if handle:
+            lib.vstree_mesh_free(handle)
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may already be unloaded
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _live(self):
+        if not self._handle:
+            raise ValueError("the mesh was closed")
+        return self._handle
+
+    @property
+    def vertex_count(self):
+        return lib.vstree_mesh_vertex_count(self._live())
+
+    @property
+    def triangle_count(self):
+        return lib.vstree_mesh_triangle_count(self._live())
+
+    @property
+    def has_normals(self):
+        return lib.vstree_mesh_has_normals(self._live()) == 1
+
+    @property
+    def positions(self):
+        """(n, 3) float32 array (a copy)."""
+        out = np.empty((self.vertex_count, 3), np.float32)
+        _check(lib.vstree_mesh_copy_positions(self._live(), out.ctypes.data_as(_ffi._F32P), out.size))
+        return out
+
+    @property
+    def normals(self):
+        """(n, 3) float32 array (a copy), or None when the mesh has none."""
+        if not self.has_normals:
+            return None
+        out = np.empty((self.vertex_count, 3), np.float32)
+        _check(lib.vstree_mesh_copy_normals(self._live(), out.ctypes.data_as(_ffi._F32P), out.size))
+        return out
+
+    @property
+    def triangles(self):
+        """(m, 3) uint32 array of vertex indices (a copy)."""
+        out = np.empty((self.triangle_count, 3), np.uint32)
+        _check(lib.vstree_mesh_copy_triangles(self._live(), out.ctypes.data_as(_ffi._U32P), out.size))
+        return out
+
+    def __repr__(self):
+        if not self._handle:
+            return "<vstree.Mesh closed>"
+        return "<vstree.Mesh %d vertices, %d triangles%s>" % (
+            self.vertex_count,
+            self.triangle_count,
+            ", normals" if self.has_normals else "",
+        )
+
+
+def load(path):
+    """Reads a mesh or point cloud: same as :meth:`Mesh.load`."""
+    return Mesh.load(path)
+
+
+def _as_rows(array, dtype, name):
+    a = np.ascontiguousarray(array, dtype=dtype)
+    if a.ndim == 1 and a.size % 3 == 0:
+        a = a.reshape(-1, 3)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError("%s must have shape (n, 3), not %s" % (name, np.shape(array)))
+    return a
+
+
+def _as_indices(triangles):
+    t = np.asarray(triangles)
+    if t.size == 0:
+        return np.zeros((0, 3), np.uint32)
+    if t.dtype.kind not in "ui":
+        raise TypeError("triangles must be integers, not %s" % t.dtype)
+    # Indices of a type wider than uint32, or signed, might not fit: check before converting
+    # (the library checks each index against the vertex count anyway).
+    fits = t.dtype.kind == "u" and t.dtype.itemsize <= 4
+    if not fits and (t.min() < 0 or t.max() > 0xFFFFFFFF):
+        raise ValueError("triangle indices must be in [0, 2^32 - 1]")
+    return _as_rows(t, np.uint32, "triangles")
+
+
+# ---- parameters -----------------------------------------------------------------------------
+
+_TREE_KINDS = {"vstree": 0, "octree": 1}
+_METRICS = {"l2": 0, "l21": 1, "density": 2}
+_SAMPLINGS = {"vertices": 0, "faces": 1, "face_centers": 1}
+_FIELDS = ("error", "d_a", "d_d", "max_depth", "threads", "min_cell_size")
+
+
+def _params(options):
+    """The C parameter struct from keyword options (the C field names; enums as names)."""
+    p = lib.vstree_simplify_params_default()
+    p.struct_size = ctypes.sizeof(_ffi.SimplifyParams)
+    for key, value in options.items():
+        if key in ("tree_kind", "metric", "sampling"):
+            names = {"tree_kind": _TREE_KINDS, "metric": _METRICS, "sampling": _SAMPLINGS}[key]
+            if isinstance(value, str):
+                if value.lower() not in names:
+                    raise ValueError("%s must be one of %s, not %r" % (key, sorted(names), value))
+                value = names[value.lower()]
+            if not -(2**31) <= int(value) < 2**31:
+                raise VstreeError(
+                    Status.INVALID_PARAMETER, "parameter `%s`: %r is out of range" % (key, value)
+                )
+            setattr(p, key, int(value))
+        elif key in _FIELDS:
+            if key in ("max_depth", "threads") and not 0 <= int(value) <= 0xFFFFFFFF:
+                raise VstreeError(
+                    Status.INVALID_PARAMETER, "parameter `%s`: %r is out of range" % (key, value)
+                )
+            setattr(p, key, value)
+        else:
+            raise TypeError("unknown vstree parameter %r" % key)
+    return p
+
+
+def _struct_dict(struct):
+    out = {}
+    for name, _ in struct._fields_:
+        if name != "struct_size":
+            out[name] = getattr(struct, name)
+    return out
+
+
+class _Progress:
+    """Adapts a Python callable ``(fraction, stage) -> bool`` to the C callback. Returning False
+    cancels; an exception inside it cancels too and is re-raised from the call."""
+
+    def __init__(self, callback):
+        self.callback = callback
+        self.error = None
+        self.c_function = _ffi.PROGRESS(self._call) if callback is not None else _ffi.PROGRESS()
+
+    def _call(self, _user_data, fraction, stage):
+        try:
+            keep_going = self.callback(fraction, stage.decode("utf-8", "replace"))
+            return 0 if keep_going is False else 1
+        except BaseException as e:  # noqa: B902 - carried across C and re-raised
+            self.error = e
+            return 0
+
+    def check(self, status):
+        if self.error is not None:
+            raise self.error
+        _check(status)
+
+
+SimplifyResult = namedtuple("SimplifyResult", ["mesh", "stats"])
+SimplifyResult.__doc__ = "The simplified :class:`Mesh` and a dict of statistics."
+
+
+def simplify(mesh, progress=None, **params):
+    """Simplifies ``mesh`` (a :class:`Mesh`, or a point cloud with normals) by clustering in a
+    VS-Tree. Parameters are the C struct's fields: ``error`` (L2: relative to the squared
+    bounding-box diagonal; default 1e-3), ``tree_kind`` ("vstree" | "octree"), ``metric``
+    ("l2" | "l21" | "density"), ``sampling`` ("vertices" | "faces"), ``d_a``, ``d_d``,
+    ``max_depth``, ``threads`` (0 = all cores), ``min_cell_size``.
+
+    ``progress(fraction, stage)`` is called on this thread; returning False cancels
+    (:class:`CancelledError`). Returns ``SimplifyResult(mesh, stats)``.
+    """
+    p = _params(params)
+    cb = _Progress(progress)
+    result = ctypes.c_void_p()
+    cb.check(lib.vstree_simplify(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
+    try:
+        stats = lib.vstree_simplify_result_get_stats(result).contents
+        if stats.struct_size < ctypes.sizeof(_ffi.SimplifyStats):
+            raise VstreeError(Status.INTERNAL, "the library's statistics are older than this module")
+        stats = _struct_dict(stats)
+    except BaseException:
+        lib.vstree_simplify_result_free(result)
+        raise
+    out = ctypes.c_void_p()
+    _check(lib.vstree_simplify_result_take_mesh(result, ctypes.byref(out)))
+    return SimplifyResult(Mesh._wrap(out.value), stats)
+
+
+class Tree:
+    """The tree :func:`simplify` would cluster ``mesh`` with (same parameters), for viewers:
+    ``stats`` (dict), ``nodes``, ``t_nodes`` (the T-layer with frames), ``levels`` (node
+    counts per depth) as numpy structured arrays, and :meth:`vertex_labels`."""
+
+    NO_INDEX = 0xFFFFFFFF
+
+    def __init__(self, mesh, progress=None, **params):
+        p = _params(params)
+        cb = _Progress(progress)
+        handle = ctypes.c_void_p()
+        cb.check(lib.vstree_tree_build(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(handle)))
+        self._handle = handle.value
+        self.stats = _struct_dict(lib.vstree_tree_get_stats(self._handle).contents)
+
+    def close(self):
+        handle, self._handle = getattr(self, "_handle", None), None
+        if handle:
+            lib.vstree_tree_free(handle)
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may already be unloaded
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _copy(self, struct, count, copy):
+        if not self._handle:
+            raise ValueError("the tree was closed")
+        out = np.zeros(count(self._handle), dtype=np.dtype(struct))
+        _check(copy(self._handle, out.ctypes.data_as(ctypes.POINTER(struct)), out.size))
+        return out
+
+    @property
+    def nodes(self):
+        """Every node: parent, first_child, child_count, kind (0 V, 1 T, 2 S), depth,
+        sample_count, t_node, cluster, center (3), half."""
+        return self._copy(_ffi.Node, lib.vstree_tree_node_count, lib.vstree_tree_copy_nodes)
+
+    @property
+    def t_nodes(self):
+        """The T-layer: node, depth, sample_count, cluster_count, cube_center, cube_half,
+        origin, normal, u, v, square_center, square_half."""
+        return self._copy(_ffi.TNode, lib.vstree_tree_t_node_count, lib.vstree_tree_copy_t_nodes)
+
+    @property
+    def levels(self):
+        """Node counts per depth: v_nodes, t_nodes, s_nodes, leaves."""
+        return self._copy(_ffi.TreeLevel, lib.vstree_tree_level_count, lib.vstree_tree_copy_levels)
+
+    def vertex_labels(self, kind="cluster"):
+        """One uint32 per input vertex: its cluster ("cluster") or its T-node's index in
+        :attr:`t_nodes` ("t_node"); ``Tree.NO_INDEX`` for none."""
+        kinds = {"cluster": 0, "t_node": 1}
+        if kind not in kinds:
+            raise ValueError("kind must be 'cluster' or 't_node', not %r" % (kind,))
+        if not self._handle:
+            raise ValueError("the tree was closed")
+        out = np.empty(lib.vstree_tree_vertex_count(self._handle), np.uint32)
+        _check(lib.vstree_tree_copy_vertex_labels(self._handle, kinds[kind], out.ctypes.data_as(_ffi._U32P), out.size))
+        return out

@@ -1,0 +1,74 @@
+//! Versioned parameter structs: each starts with `uint32_t struct_size`, which its `_default()`
+//! sets to the size the caller was compiled with. A library that knows a larger struct reads
+//! only the caller's prefix and keeps its defaults for the fields added since; a caller built
+//! against a newer header than the library is refused with a message saying so.
+
+use super::{Failure, FfiResult};
+use std::mem::size_of;
+
+/// A `#[repr(C)]` parameter struct that starts with `struct_size: u32`, has no padding, and
+/// whose fields are plain integers and floats, so any bytes are a valid value (enum-like
+/// fields are `int32_t` checked after reading).
+pub(crate) unsafe trait Versioned: Copy {
+    /// The C type name, for messages.
+    const NAME: &'static str;
+    /// The size of the first published layout: the smallest `struct_size` accepted.
+    const MIN_SIZE: usize;
+    /// The values `_default()` returns.
+    fn defaults() -> Self;
+}
+
+/// Reads the caller's struct at `pointer` (NULL gives the defaults).
+///
+/// # Safety
+/// A non-NULL `pointer` must point to at least `struct_size` readable bytes, `struct_size` being
+/// the value of its first four bytes.
+pub(crate) unsafe fn read<T: Versioned>(pointer: *const T, argument: &str) -> FfiResult<T> {
+    if pointer.is_null() {
+        return Ok(T::defaults());
+    }
+    if (pointer as usize) % std::mem::align_of::<T>() != 0 {
+        return Err(Failure::argument(argument, "pointer is misaligned"));
+    }
+    // SAFETY: non-NULL and aligned; every version of the struct begins with a u32.
+    let size = unsafe { pointer.cast::<u32>().read() } as usize;
+    if size < T::MIN_SIZE || size > size_of::<T>() {
+        let hint = if size > size_of::<T>() {
+            "the program was compiled against a newer vstree.h than this library"
+        } else {
+            "initialise the struct with its _default() function"
+        };
+        return Err(Failure::argument(
+            &format!("{argument}->struct_size"),
+            format!(
+                "{size} is not a size of {} this library knows ({} to {}): {hint}",
+                T::NAME,
+                T::MIN_SIZE,
+                size_of::<T>()
+            ),
+        ));
+    }
+    let mut value = T::defaults();
+    // SAFETY: the caller's struct has `size` readable bytes; `value` has `size_of::<T>() >=
+    // size` bytes; every byte pattern is a valid `T` (the trait's contract).
+    unsafe {
+        std::ptr::copy_nonoverlapping(
+            pointer.cast::<u8>(),
+            (&mut value as *mut T).cast::<u8>(),
+            size,
+        )
+    };
+    Ok(value)
+}
+
+/// Checks that an enum-like `int32_t` field holds one of `allowed`.
+pub(crate) fn one_of(field: &str, value: i32, allowed: &[(i32, &str)]) -> FfiResult<i32> {
+    if allowed.iter().any(|&(v, _)| v == value) {
+        return Ok(value);
+    }
+    let names: Vec<String> = allowed.iter().map(|(v, n)| format!("{v} ({n})")).collect();
+    Err(Failure::parameter(
+        field,
+        format!("{value}: must be one of {}", names.join(", ")),
+    ))
+}

@@ -1,0 +1,267 @@
+"""The ctypes module (bindings/python/vstree): numpy in and out, errors as VstreeError with the
+status and message, progress that cancels, exceptions through callbacks, the tree for viewers,
+threads, library lookup and the ABI check."""
+
+import os
+import re
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+
+import vstree
+from conftest import ROOT
+
+
+def torus(rings=64, segments=32, bump=0.2):
+    u = np.linspace(0, 2 * np.pi, rings, endpoint=False)[:, None]
+    v = np.linspace(0, 2 * np.pi, segments, endpoint=False)[None, :]
+    r = 0.3 * (1 + bump * np.sin(5 * u) * np.sin(3 * v))
+    p = np.stack(
+        [(1 + r * np.cos(v)) * np.cos(u), (1 + r * np.cos(v)) * np.sin(u), r * np.sin(v) + 0 * u],
+        axis=-1,
+    ).reshape(-1, 3)
+    n = np.stack(
+        [np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v) + 0 * u], axis=-1
+    ).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(rings), np.arange(segments), indexing="ij")
+    a = i * segments + j
+    b = (i + 1) % rings * segments + j
+    c = (i + 1) % rings * segments + (j + 1) % segments
+    d = i * segments + (j + 1) % segments
+    t = np.concatenate([np.stack([a, b, c], -1), np.stack([a, c, d], -1)]).reshape(-1, 3)
+    return p.astype(np.float32), t.astype(np.uint32), n.astype(np.float32)
+
+
+@pytest.fixture(scope="module")
+def shape():
+    return torus()
+
+
+def test_version_and_abi_agree_with_cargo_toml():
+    cargo = open(os.path.join(ROOT, "Cargo.toml")).read()
+    assert vstree.version == re.search(r'^version = "([^"]+)"', cargo, re.M).group(1)
+    header = open(os.path.join(ROOT, "include", "vstree.h")).read()
+    abi = int(re.search(r"#define VSTREE_ABI_VERSION (\d+)", header).group(1))
+    assert vstree.ABI_VERSION == abi
+
+
+def test_arrays_round_trip(shape):
+    p, t, n = shape
+    m = vstree.Mesh(p, t, n)
+    assert (m.vertex_count, m.triangle_count, m.has_normals) == (len(p), len(t), True)
+    np.testing.assert_array_equal(m.positions, p)
+    np.testing.assert_array_equal(m.triangles, t)
+    np.testing.assert_array_equal(m.normals, n)
+    # Other dtypes and flat arrays are converted; a cloud has no triangles.
+    cloud = vstree.Mesh(p.astype(np.float64).ravel(), None, n)
+    assert cloud.triangle_count == 0 and cloud.triangles.shape == (0, 3)
+    assert vstree.Mesh(p, t.astype(np.int64)).triangle_count == len(t)
+    assert vstree.Mesh(p).normals is None
+
+
+def test_simplify_gives_a_smaller_mesh_and_statistics(shape):
+    p, t, _ = shape
+    result = vstree.simplify(vstree.Mesh(p, t), error=2e-3)
+    out, s = result.mesh, result.stats
+    assert 10 < out.vertex_count < len(p)
+    assert s["output_vertices"] == out.vertex_count and s["output_triangles"] == out.triangle_count
+    assert s["input_triangles"] == len(t) and s["clusters"] >= out.vertex_count
+    assert s["t_nodes"] > 0 and s["nodes"] == s["v_nodes"] + s["t_nodes"] + s["s_nodes"]
+    assert s["seconds_total"] >= s["seconds_tree"] >= 0
+    assert out.triangles.max() < out.vertex_count
+    coarser = vstree.simplify(vstree.Mesh(p, t), error=2e-2).mesh
+    assert coarser.vertex_count < out.vertex_count
+    octree = vstree.simplify(vstree.Mesh(p, t), error=2e-3, tree_kind="octree").stats
+    assert octree["t_nodes"] == 0
+
+
+def test_point_clouds_with_normals_simplify_to_points(shape):
+    p, _, n = shape
+    result = vstree.simplify(vstree.Mesh(p, None, n), metric="density", error=16)
+    assert result.mesh.triangle_count == 0 and result.mesh.has_normals
+    assert result.stats["output_vertices"] == result.stats["clusters"]
+
+
+@pytest.mark.parametrize(
+    "field, value",
+    [
+        ("error", 0.0),
+        ("error", float("nan")),
+        ("error", -1.0),
+        ("d_a", 2.0),
+        ("d_d", float("nan")),
+        ("max_depth", 0),
+        ("max_depth", 99),
+        ("threads", 5000),
+        ("min_cell_size", 1.0),
+        ("tree_kind", 7),
+        ("metric", -1),
+        ("sampling", 2**40),
+        ("max_depth", -1),
+    ],
+)
+def test_bad_parameters_name_the_field(shape, field, value):
+    p, t, _ = shape
+    with pytest.raises(vstree.VstreeError) as e:
+        vstree.simplify(vstree.Mesh(p, t), **{field: value})
+    assert e.value.status == vstree.Status.INVALID_PARAMETER
+    assert "`%s`" % field in e.value.message
+
+
+def test_bad_arrays(shape):
+    p, t, n = shape
+    bad = p.copy()
+    bad[5, 1] = np.nan
+    with pytest.raises(vstree.VstreeError) as e:
+        vstree.Mesh(bad, t)
+    assert e.value.status == vstree.Status.INVALID_INPUT and "vertex 5" in e.value.message
+    wrong = t.copy()
+    wrong[3, 2] = len(p)
+    with pytest.raises(vstree.VstreeError, match="triangle 3 uses vertex"):
+        vstree.Mesh(p, wrong)
+    with pytest.raises(vstree.VstreeError) as e:
+        vstree.Mesh(np.zeros((0, 3)))
+    assert e.value.status == vstree.Status.INVALID_INPUT
+    with pytest.raises(ValueError):
+        vstree.Mesh(p[:, :2])
+    with pytest.raises(ValueError):
+        vstree.Mesh(p, t.astype(np.int64) - 1)
+    with pytest.raises(TypeError):
+        vstree.Mesh(p, t.astype(np.float32))
+    with pytest.raises(ValueError):
+        vstree.Mesh(p, t, n[:-1])
+    with pytest.raises(TypeError):
+        vstree.simplify(vstree.Mesh(p, t), eror=1e-3)
+    with pytest.raises(vstree.VstreeError, match="normals") as e:
+        vstree.simplify(vstree.Mesh(p))
+    assert e.value.status == vstree.Status.INVALID_INPUT
+
+
+def test_progress_reports_and_cancels(shape):
+    p, t, _ = shape
+    mesh = vstree.Mesh(p, t)
+    seen = []
+    vstree.simplify(mesh, progress=lambda f, stage: seen.append((f, stage)))
+    fractions = [f for f, _ in seen]
+    assert len(seen) >= 3 and fractions == sorted(fractions) and fractions[-1] == 1.0
+    assert seen[-1][1] == "done"
+    for k in range(len(seen)):
+        calls = []
+
+        def stop_at_k(f, stage, k=k):
+            calls.append(f)
+            return len(calls) <= k
+
+        with pytest.raises(vstree.CancelledError) as e:
+            vstree.simplify(mesh, progress=stop_at_k)
+        assert e.value.status == vstree.Status.CANCELLED and len(calls) == k + 1
+
+
+def test_an_exception_in_the_callback_comes_out_of_the_call(shape):
+    p, t, _ = shape
+
+    def boom(f, stage):
+        if f > 0.5:
+            raise KeyError("host gave up")
+
+    with pytest.raises(KeyError, match="host gave up"):
+        vstree.Tree(vstree.Mesh(p, t), progress=boom)
+
+
+def test_files_and_memory(tmp_path, shape):
+    p, t, n = shape
+    mesh = vstree.Mesh(p, t, n)
+    for name, ascii in [("a.ply", False), ("b.ply", True), ("c.off", False), ("d.obj", False)]:
+        path = tmp_path / name
+        mesh.save(path, ascii=ascii)
+        back = vstree.load(str(path))
+        assert (back.vertex_count, back.triangle_count) == (len(p), len(t))
+        same = vstree.Mesh.from_bytes(path.read_bytes(), name)
+        np.testing.assert_array_equal(same.positions, back.positions)
+    np.testing.assert_allclose(vstree.load(tmp_path / "a.ply").positions, p)
+    with pytest.raises(vstree.VstreeError) as e:
+        vstree.load(tmp_path / "missing.ply")
+    assert e.value.status == vstree.Status.IO and "missing.ply" in e.value.message
+    with pytest.raises(vstree.VstreeError) as e:
+        vstree.Mesh.from_bytes(b"OFF\n3 1 0\n0 0 0\n", "broken.off")
+    assert e.value.status == vstree.Status.PARSE and "broken.off" in e.value.message
+    with pytest.raises(vstree.VstreeError) as e:
+        mesh.save(tmp_path / "x.stl")
+    assert e.value.status == vstree.Status.UNSUPPORTED_FORMAT
+
+
+def test_tree_arrays_and_labels(shape):
+    p, t, _ = shape
+    mesh = vstree.Mesh(p, t)
+    tree = vstree.Tree(mesh, error=2e-3)
+    s = tree.stats
+    nodes, layer, levels = tree.nodes, tree.t_nodes, tree.levels
+    assert len(nodes) == s["nodes"] and len(layer) == s["t_nodes"] > 0
+    assert len(levels) == s["max_depth"] + 1
+    assert levels["leaves"].sum() == s["clusters"] and levels["t_nodes"].sum() == s["t_nodes"]
+    assert (nodes["kind"][layer["node"]] == 1).all()
+    np.testing.assert_allclose(np.linalg.norm(layer["normal"], axis=1), 1, atol=1e-5)
+    assert s["max_cluster_error"] <= 2e-3 * 1.0001
+    clusters = tree.vertex_labels()
+    t_labels = tree.vertex_labels("t_node")
+    assert clusters.shape == (len(p),) and clusters.max() < s["clusters"]
+    assert ((t_labels < s["t_nodes"]) | (t_labels == vstree.Tree.NO_INDEX)).all()
+    leaves = nodes[nodes["child_count"] == 0]
+    np.testing.assert_array_equal(leaves["cluster"], np.arange(s["clusters"]))
+    np.testing.assert_array_equal(leaves["t_node"][clusters], t_labels)
+    with pytest.raises(ValueError):
+        tree.vertex_labels("depth")
+    tree.close()
+    with pytest.raises(ValueError):
+        tree.nodes
+
+
+def test_threads_simplifying_different_meshes_match_one_thread():
+    meshes = [vstree.Mesh(*torus(48 + 16 * i, 24 + 4 * i, 0.1 * (i + 1))[:2]) for i in range(4)]
+    expected = [vstree.simplify(m, threads=1).mesh.positions for m in meshes]
+    results = [None] * 8
+    errors = []
+
+    def work(k):
+        try:
+            results[k] = vstree.simplify(meshes[k % 4], threads=k % 3).mesh.positions
+        except Exception as e:  # pragma: no cover - reported below
+            errors.append(e)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(8)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert not errors
+    for k, out in enumerate(results):
+        np.testing.assert_array_equal(out, expected[k % 4])
+
+
+def _import_in_subprocess(env, path):
+    code = "import vstree, sys; print(vstree.library_path)"
+    return subprocess.run(
+        [sys.executable, "-c", code], env=env, cwd=path, capture_output=True, text=True
+    )
+
+
+def test_library_next_to_the_module_and_bad_paths(tmp_path):
+    lib = os.environ["VSTREE_LIBRARY"]
+    package = tmp_path / "vstree"
+    package.mkdir()
+    for name in ("__init__.py", "_ffi.py"):
+        src = os.path.join(ROOT, "bindings", "python", "vstree", name)
+        (package / name).write_text(open(src).read())
+    (package / "libvstree.so").write_bytes(open(lib, "rb").read())
+    env = {k: v for k, v in os.environ.items() if k != "VSTREE_LIBRARY"}
+    env["PYTHONPATH"] = str(tmp_path)
+    found = _import_in_subprocess(env, tmp_path)
+    assert found.returncode == 0, found.stderr
+    assert found.stdout.strip() == str(package / "libvstree.so")
+    env["VSTREE_LIBRARY"] = str(tmp_path / "nowhere.so")
+    missing = _import_in_subprocess(env, tmp_path)
+    assert missing.returncode != 0 and "VSTREE_LIBRARY" in missing.stderr
+    assert "nowhere.so" in missing.stderr
