@@ -20,10 +20,7 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed={SOURCE}");
     let os = std::env::var("CARGO_CFG_TARGET_OS").unwrap_or_default();
-    let elf = matches!(
-        os.as_str(),
-        "linux" | "android" | "freebsd" | "netbsd" | "openbsd" | "dragonfly" | "illumos"
-    );
+    let elf = matches!(os.as_str(), "linux" | "android" | "freebsd" | "netbsd" | "openbsd" | "dragonfly" | "illumos");
     if elf {
         let abi = abi_version();
         println!("cargo:rustc-cdylib-link-arg=-Wl,-soname,libvstree.so.{abi}");

@@ -60,9 +60,7 @@ fn main() {
     let triangles: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
     let create = || {
         let mut m = null_mut();
-        let s = unsafe {
-            vstree_mesh_create(positions.as_ptr(), n, null(), triangles.as_ptr(), t, &mut m)
-        };
+        let s = unsafe { vstree_mesh_create(positions.as_ptr(), n, null(), triangles.as_ptr(), t, &mut m) };
         assert_eq!(s, vstree_status::Ok);
         m
     };
@@ -76,13 +74,8 @@ fn main() {
     for error in ERRORS {
         let mut c_params = vstree_simplify_params_default();
         c_params.error = error;
-        let params = SimplifyParams {
-            tree: TreeParams {
-                error,
-                ..TreeParams::default()
-            },
-            ..SimplifyParams::default()
-        };
+        let params =
+            SimplifyParams { tree: TreeParams { error, ..TreeParams::default() }, ..SimplifyParams::default() };
         let (mut rust, mut call_extra, mut host, mut host_extra) = (vec![], vec![], vec![], vec![]);
         let mut output_triangles = 0;
         for run in 0..runs {

@@ -47,7 +47,7 @@ fn normals_timing_1m_5m() {
             // When each stage started, as the progress callback sees it.
             let mut starts: Vec<(String, Instant)> = Vec::new();
             let mut record = |_: f32, stage: &str| {
-                if starts.last().map_or(true, |(name, _)| name != stage) {
+                if starts.last().is_none_or(|(name, _)| name != stage) {
                     starts.push((stage.to_string(), Instant::now()));
                 }
                 true

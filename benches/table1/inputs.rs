@@ -33,7 +33,7 @@ pub fn models(data: &Path, only: Option<&[String]>) -> Vec<Input> {
                 .and_then(|e| e.to_str())
                 .is_some_and(|e| EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
         })
-        .filter(|p| only.map_or(true, |names| names.iter().any(|n| *n == stem(p))))
+        .filter(|p| only.is_none_or(|names| names.iter().any(|n| *n == stem(p))))
         .collect();
     paths.sort();
     let mut inputs: Vec<Input> = paths.iter().filter_map(|p| model(p)).collect();

@@ -20,10 +20,7 @@ pub(crate) fn elements(count: usize, k: usize, argument: &str) -> FfiResult<usiz
     }
     count
         .checked_mul(k)
-        .filter(|&n| {
-            n.checked_mul(size_of::<f64>())
-                .is_some_and(|b| b <= isize::MAX as usize)
-        })
+        .filter(|&n| n.checked_mul(size_of::<f64>()).is_some_and(|b| b <= isize::MAX as usize))
         .ok_or_else(|| {
             Failure::new(
                 vstree_status::TooLarge,
@@ -36,10 +33,7 @@ fn check_alignment<T>(pointer: *const T, argument: &str) -> FfiResult {
     if (pointer as usize) % align_of::<T>() != 0 {
         return Err(Failure::argument(
             argument,
-            format!(
-                "{pointer:p} is not aligned to {} bytes as its element type requires",
-                align_of::<T>()
-            ),
+            format!("{pointer:p} is not aligned to {} bytes as its element type requires", align_of::<T>()),
         ));
     }
     Ok(())
@@ -50,11 +44,7 @@ fn check_alignment<T>(pointer: *const T, argument: &str) -> FfiResult {
 ///
 /// # Safety
 /// When `len > 0`, `pointer` must point to `len` readable elements that stay unchanged for `'a`.
-pub(crate) unsafe fn input<'a, T>(
-    pointer: *const T,
-    len: usize,
-    argument: &str,
-) -> FfiResult<&'a [T]> {
+pub(crate) unsafe fn input<'a, T>(pointer: *const T, len: usize, argument: &str) -> FfiResult<&'a [T]> {
     if len == 0 {
         return Ok(&[]);
     }
@@ -73,19 +63,11 @@ pub(crate) unsafe fn input<'a, T>(
 /// # Safety
 /// `out` must point to `capacity` writable elements (or be NULL, which is refused unless `data`
 /// is empty).
-pub(crate) unsafe fn copy_out<T: Copy>(
-    data: &[T],
-    out: *mut T,
-    capacity: usize,
-    argument: &str,
-) -> FfiResult {
+pub(crate) unsafe fn copy_out<T: Copy>(data: &[T], out: *mut T, capacity: usize, argument: &str) -> FfiResult {
     if capacity < data.len() {
         return Err(Failure::new(
             vstree_status::BufferTooSmall,
-            format!(
-                "`capacity` is {capacity}, but {} elements are needed for `{argument}`",
-                data.len()
-            ),
+            format!("`capacity` is {capacity}, but {} elements are needed for `{argument}`", data.len()),
         ));
     }
     if data.is_empty() {
@@ -104,12 +86,8 @@ pub(crate) unsafe fn copy_out<T: Copy>(
 /// A vector with room for `n` elements, or [`vstree_status::OutOfMemory`] instead of an abort.
 pub(crate) fn with_capacity<T>(n: usize, what: &str) -> FfiResult<Vec<T>> {
     let mut v = Vec::new();
-    v.try_reserve_exact(n).map_err(|_| {
-        Failure::new(
-            vstree_status::OutOfMemory,
-            format!("cannot allocate {n} elements for {what}"),
-        )
-    })?;
+    v.try_reserve_exact(n)
+        .map_err(|_| Failure::new(vstree_status::OutOfMemory, format!("cannot allocate {n} elements for {what}")))?;
     Ok(v)
 }
 
@@ -123,10 +101,7 @@ mod tests {
         let e = elements(MAX_COUNT + 1, 3, "vertex_count").unwrap_err();
         assert_eq!(e.status, vstree_status::TooLarge);
         assert!(e.message.contains("vertex_count"));
-        assert_eq!(
-            elements(usize::MAX, 3, "n").unwrap_err().status,
-            vstree_status::TooLarge
-        );
+        assert_eq!(elements(usize::MAX, 3, "n").unwrap_err().status, vstree_status::TooLarge);
     }
 
     #[test]

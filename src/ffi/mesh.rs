@@ -99,9 +99,7 @@ pub unsafe extern "C" fn vstree_mesh_create(
         let triangles = unsafe { input(triangles, indices, "triangles") }?;
         let mesh = Mesh {
             positions: triples::<f32, Vec3>(positions, "positions")?,
-            normals: normals
-                .map(|n| triples::<f32, Vec3>(n, "normals"))
-                .transpose()?,
+            normals: normals.map(|n| triples::<f32, Vec3>(n, "normals")).transpose()?,
             triangles: triples::<u32, [u32; 3]>(triangles, "triangles")?,
         };
         mesh.check()?;
@@ -140,10 +138,7 @@ unsafe fn path_arg(path: *const c_char, argument: &str) -> FfiResult<PathBuf> {
 /// VSTREE_STATUS_UNSUPPORTED_FORMAT, VSTREE_STATUS_IO, VSTREE_STATUS_PARSE (the message gives
 /// the line or element) or VSTREE_STATUS_INVALID_INPUT. Thread-safe.
 #[no_mangle]
-pub unsafe extern "C" fn vstree_mesh_load(
-    path: *const c_char,
-    out_mesh: *mut *mut vstree_mesh,
-) -> vstree_status {
+pub unsafe extern "C" fn vstree_mesh_load(path: *const c_char, out_mesh: *mut *mut vstree_mesh) -> vstree_status {
     guard("vstree_mesh_load", || {
         non_null(out_mesh, "out_mesh")?;
         let path = unsafe { path_arg(path, "path") }?;
@@ -177,8 +172,7 @@ pub unsafe extern "C" fn vstree_mesh_load_memory(
             Some(_) => name,
             None => Path::new("memory").with_extension(&name),
         };
-        let format = Format::from_path(&name)
-            .ok_or_else(|| crate::Error::UnsupportedFormat { path: name.clone() })?;
+        let format = Format::from_path(&name).ok_or_else(|| crate::Error::UnsupportedFormat { path: name.clone() })?;
         if size > isize::MAX as usize {
             return Err(Failure::new(
                 vstree_status::TooLarge,
@@ -203,11 +197,7 @@ pub unsafe extern "C" fn vstree_mesh_load_memory(
 /// flag bits), VSTREE_STATUS_UNSUPPORTED_FORMAT or VSTREE_STATUS_IO. Thread-safe (two threads
 /// must not write the same path at once).
 #[no_mangle]
-pub unsafe extern "C" fn vstree_mesh_save(
-    mesh: *const vstree_mesh,
-    path: *const c_char,
-    flags: u32,
-) -> vstree_status {
+pub unsafe extern "C" fn vstree_mesh_save(mesh: *const vstree_mesh, path: *const c_char, flags: u32) -> vstree_status {
     guard("vstree_mesh_save", || {
         let mesh = unsafe { mesh_ref(mesh, "mesh") }?;
         let path = unsafe { path_arg(path, "path") }?;
@@ -217,9 +207,7 @@ pub unsafe extern "C" fn vstree_mesh_save(
                 format!("{flags:#x} has unknown bits (known: VSTREE_SAVE_ASCII = 1)"),
             ));
         }
-        let options = WriteOptions {
-            ascii: flags & VSTREE_SAVE_ASCII != 0,
-        };
+        let options = WriteOptions { ascii: flags & VSTREE_SAVE_ASCII != 0 };
         io::write_with(&path, mesh, &options)?;
         Ok(())
     })
@@ -241,25 +229,19 @@ pub unsafe extern "C" fn vstree_mesh_free(mesh: *mut vstree_mesh) {
 /// The number of vertices (points, for a point cloud); 0 for NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_mesh_vertex_count(mesh: *const vstree_mesh) -> usize {
-    guard_or(0, || {
-        unsafe { mesh_ref(mesh, "mesh") }.map_or(0, |m| m.positions.len())
-    })
+    guard_or(0, || unsafe { mesh_ref(mesh, "mesh") }.map_or(0, |m| m.positions.len()))
 }
 
 /// The number of triangles (0 for a point cloud, and for NULL). Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_mesh_triangle_count(mesh: *const vstree_mesh) -> usize {
-    guard_or(0, || {
-        unsafe { mesh_ref(mesh, "mesh") }.map_or(0, |m| m.triangles.len())
-    })
+    guard_or(0, || unsafe { mesh_ref(mesh, "mesh") }.map_or(0, |m| m.triangles.len()))
 }
 
 /// 1 if the mesh has per-vertex normals, 0 if not (or NULL). Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_mesh_has_normals(mesh: *const vstree_mesh) -> i32 {
-    guard_or(0, || {
-        unsafe { mesh_ref(mesh, "mesh") }.map_or(0, |m| i32::from(m.normals.is_some()))
-    })
+    guard_or(0, || unsafe { mesh_ref(mesh, "mesh") }.map_or(0, |m| i32::from(m.normals.is_some())))
 }
 
 fn flat(v: &[Vec3]) -> &[f32] {
@@ -297,9 +279,10 @@ pub unsafe extern "C" fn vstree_mesh_copy_normals(
 ) -> vstree_status {
     guard("vstree_mesh_copy_normals", || {
         let mesh = unsafe { mesh_ref(mesh, "mesh") }?;
-        let normals = mesh.normals.as_deref().ok_or_else(|| {
-            Failure::argument("mesh", "has no normals (see vstree_mesh_has_normals)")
-        })?;
+        let normals = mesh
+            .normals
+            .as_deref()
+            .ok_or_else(|| Failure::argument("mesh", "has no normals (see vstree_mesh_has_normals)"))?;
         unsafe { copy_out(flat(normals), out, capacity, "out") }
     })
 }
@@ -318,12 +301,8 @@ pub unsafe extern "C" fn vstree_mesh_copy_triangles(
     guard("vstree_mesh_copy_triangles", || {
         let mesh = unsafe { mesh_ref(mesh, "mesh") }?;
         // SAFETY: [u32; 3] is three packed u32.
-        let indices = unsafe {
-            std::slice::from_raw_parts(
-                mesh.triangles.as_ptr().cast::<u32>(),
-                mesh.triangles.len() * 3,
-            )
-        };
+        let indices =
+            unsafe { std::slice::from_raw_parts(mesh.triangles.as_ptr().cast::<u32>(), mesh.triangles.len() * 3) };
         unsafe { copy_out(indices, out, capacity, "out") }
     })
 }

@@ -92,10 +92,7 @@ pub(crate) type FfiResult<T = ()> = Result<T, Failure>;
 
 impl Failure {
     pub fn new(status: vstree_status, message: impl Into<String>) -> Failure {
-        Failure {
-            status,
-            message: message.into(),
-        }
+        Failure { status, message: message.into() }
     }
 
     /// A NULL pointer where `argument` must point somewhere.
@@ -104,17 +101,11 @@ impl Failure {
     }
 
     pub fn argument(argument: &str, message: impl std::fmt::Display) -> Failure {
-        Failure::new(
-            vstree_status::InvalidArgument,
-            format!("`{argument}`: {message}"),
-        )
+        Failure::new(vstree_status::InvalidArgument, format!("`{argument}`: {message}"))
     }
 
     pub fn parameter(field: &str, message: impl std::fmt::Display) -> Failure {
-        Failure::new(
-            vstree_status::InvalidParameter,
-            format!("parameter `{field}`: {message}"),
-        )
+        Failure::new(vstree_status::InvalidParameter, format!("parameter `{field}`: {message}"))
     }
 }
 
@@ -250,9 +241,7 @@ pub extern "C" fn vstree_status_str(status: i32) -> *const c_char {
 #[no_mangle]
 pub extern "C" fn vstree_last_error_message() -> *const c_char {
     guard_or(c"".as_ptr(), || {
-        LAST_ERROR
-            .try_with(|slot| slot.try_borrow().map_or(c"".as_ptr(), |m| m.as_ptr()))
-            .unwrap_or(c"".as_ptr())
+        LAST_ERROR.try_with(|slot| slot.try_borrow().map_or(c"".as_ptr(), |m| m.as_ptr())).unwrap_or(c"".as_ptr())
     })
 }
 
@@ -291,9 +280,7 @@ mod tests {
     use super::*;
 
     fn last() -> String {
-        unsafe { CStr::from_ptr(vstree_last_error_message()) }
-            .to_string_lossy()
-            .into_owned()
+        unsafe { CStr::from_ptr(vstree_last_error_message()) }.to_string_lossy().into_owned()
     }
 
     #[test]
@@ -310,9 +297,7 @@ mod tests {
     fn library_errors_map_to_their_statuses() {
         let status = guard("f", || Err(Error::Cancelled.into()));
         assert_eq!(status, vstree_status::Cancelled);
-        let status = guard("f", || {
-            Err(Error::param("d_a", "2: must be in [0, 1]").into())
-        });
+        let status = guard("f", || Err(Error::param("d_a", "2: must be in [0, 1]").into()));
         assert_eq!(status, vstree_status::InvalidParameter);
         assert_eq!(last(), "f: parameter `d_a`: 2: must be in [0, 1]");
     }
@@ -332,10 +317,7 @@ mod tests {
         assert_eq!(n, full.len());
         let copied = unsafe { CStr::from_ptr(buffer.as_ptr()) }.to_str().unwrap();
         assert!(full.starts_with(copied) && copied.len() < 8, "{copied}");
-        assert_eq!(
-            unsafe { vstree_last_error_copy(std::ptr::null_mut(), 0) },
-            n
-        );
+        assert_eq!(unsafe { vstree_last_error_copy(std::ptr::null_mut(), 0) }, n);
     }
 
     #[test]

@@ -51,13 +51,7 @@ pub(crate) unsafe fn read<T: Versioned>(pointer: *const T, argument: &str) -> Ff
     let mut value = T::defaults();
     // SAFETY: the caller's struct has `size` readable bytes; `value` has `size_of::<T>() >=
     // size` bytes; every byte pattern is a valid `T` (the trait's contract).
-    unsafe {
-        std::ptr::copy_nonoverlapping(
-            pointer.cast::<u8>(),
-            (&mut value as *mut T).cast::<u8>(),
-            size,
-        )
-    };
+    unsafe { std::ptr::copy_nonoverlapping(pointer.cast::<u8>(), (&mut value as *mut T).cast::<u8>(), size) };
     Ok(value)
 }
 
@@ -67,8 +61,5 @@ pub(crate) fn one_of(field: &str, value: i32, allowed: &[(i32, &str)]) -> FfiRes
         return Ok(value);
     }
     let names: Vec<String> = allowed.iter().map(|(v, n)| format!("{v} ({n})")).collect();
-    Err(Failure::parameter(
-        field,
-        format!("{value}: must be one of {}", names.join(", ")),
-    ))
+    Err(Failure::parameter(field, format!("{value}: must be one of {}", names.join(", "))))
 }

@@ -13,9 +13,8 @@ use std::ffi::{c_char, c_void, CString};
 /// Called only from the thread that made the vstree call, never concurrently. It must not
 /// unwind (throw a C++ exception or longjmp) out of itself; it may call vstree functions,
 /// including the last-error ones, but must not free handles the running call uses.
-pub type vstree_progress_fn = Option<
-    unsafe extern "C" fn(user_data: *mut c_void, fraction: f32, stage: *const c_char) -> i32,
->;
+pub type vstree_progress_fn =
+    Option<unsafe extern "C" fn(user_data: *mut c_void, fraction: f32, stage: *const c_char) -> i32>;
 
 /// Runs `work` with a [`Progress`] that forwards to `callback` (none: never cancelled).
 pub(crate) fn with_progress<R>(

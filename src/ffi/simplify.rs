@@ -113,29 +113,17 @@ pub extern "C" fn vstree_simplify_params_default() -> vstree_simplify_params {
 }
 
 /// Reads and checks the caller's parameters (NULL: defaults), naming any bad field.
-pub(crate) unsafe fn read_params(
-    pointer: *const vstree_simplify_params,
-) -> FfiResult<SimplifyParams> {
+pub(crate) unsafe fn read_params(pointer: *const vstree_simplify_params) -> FfiResult<SimplifyParams> {
     let p = unsafe { params::read(pointer, "params") }?;
-    let kind = match one_of(
-        "tree_kind",
-        p.tree_kind,
-        &[
-            (0, "VSTREE_TREE_KIND_VS_TREE"),
-            (1, "VSTREE_TREE_KIND_OCTREE"),
-        ],
-    )? {
-        0 => TreeKind::VsTree,
-        _ => TreeKind::Octree,
-    };
+    let kind =
+        match one_of("tree_kind", p.tree_kind, &[(0, "VSTREE_TREE_KIND_VS_TREE"), (1, "VSTREE_TREE_KIND_OCTREE")])? {
+            0 => TreeKind::VsTree,
+            _ => TreeKind::Octree,
+        };
     let metric = match one_of(
         "metric",
         p.metric,
-        &[
-            (0, "VSTREE_METRIC_L2"),
-            (1, "VSTREE_METRIC_L21"),
-            (2, "VSTREE_METRIC_DENSITY"),
-        ],
+        &[(0, "VSTREE_METRIC_L2"), (1, "VSTREE_METRIC_L21"), (2, "VSTREE_METRIC_DENSITY")],
     )? {
         0 => Metric::L2,
         1 => Metric::L21,
@@ -144,10 +132,7 @@ pub(crate) unsafe fn read_params(
     let sampling = match one_of(
         "sampling",
         p.sampling,
-        &[
-            (0, "VSTREE_SAMPLING_VERTICES"),
-            (1, "VSTREE_SAMPLING_FACE_CENTERS"),
-        ],
+        &[(0, "VSTREE_SAMPLING_VERTICES"), (1, "VSTREE_SAMPLING_FACE_CENTERS")],
     )? {
         0 => MeshSampling::Vertices,
         _ => MeshSampling::FaceCenters,
@@ -163,16 +148,9 @@ pub(crate) unsafe fn read_params(
     };
     tree.check()?;
     if p.threads > 1024 {
-        return Err(super::Failure::parameter(
-            "threads",
-            format!("{}: must be 0 (all cores) to 1024", p.threads),
-        ));
+        return Err(super::Failure::parameter("threads", format!("{}: must be 0 (all cores) to 1024", p.threads)));
     }
-    Ok(SimplifyParams {
-        tree,
-        sampling,
-        threads: p.threads as usize,
-    })
+    Ok(SimplifyParams { tree, sampling, threads: p.threads as usize })
 }
 
 /// What a simplification did. Owned by its result (vstree_simplify_result_get_stats()); later
@@ -224,10 +202,7 @@ pub struct vstree_simplify_stats {
 
 /// Fills the tree part of a stats struct.
 pub(crate) fn tree_figures(s: &TreeStats) -> [u64; 6] {
-    [
-        s.samples, s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.leaves,
-    ]
-    .map(|n| n as u64)
+    [s.samples, s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.leaves].map(|n| n as u64)
 }
 
 /// The output of vstree_simplify(): the simplified mesh and what was done. Opaque; freed with
@@ -290,10 +265,7 @@ pub unsafe extern "C" fn vstree_simplify(
             seconds_cluster: s.seconds_cluster,
             seconds_total: start.elapsed().as_secs_f64(),
         };
-        let result = Box::new(vstree_simplify_result {
-            mesh: vstree_mesh { mesh: out },
-            stats,
-        });
+        let result = Box::new(vstree_simplify_result { mesh: vstree_mesh { mesh: out }, stats });
         unsafe { write_out(out_result, Box::into_raw(result)) };
         Ok(())
     })
@@ -303,9 +275,7 @@ pub unsafe extern "C" fn vstree_simplify(
 /// and never to be passed to vstree_mesh_free(). Use it with every `const vstree_mesh *`
 /// function (counts, copies, vstree_mesh_save(), even vstree_simplify() again). NULL for NULL.
 #[no_mangle]
-pub unsafe extern "C" fn vstree_simplify_result_get_mesh(
-    result: *const vstree_simplify_result,
-) -> *const vstree_mesh {
+pub unsafe extern "C" fn vstree_simplify_result_get_mesh(result: *const vstree_simplify_result) -> *const vstree_mesh {
     guard_or(std::ptr::null(), || match result.is_null() {
         true => std::ptr::null(),
         // SAFETY: a live result from vstree_simplify(), by the caller's contract.
@@ -379,10 +349,7 @@ mod tests {
         assert_eq!(e.status, vstree_status::InvalidArgument);
         assert!(e.message.contains("params->struct_size"), "{}", e.message);
         p.struct_size = 4096;
-        assert!(unsafe { read_params(&p) }
-            .unwrap_err()
-            .message
-            .contains("newer vstree.h"));
+        assert!(unsafe { read_params(&p) }.unwrap_err().message.contains("newer vstree.h"));
     }
 
     #[test]

@@ -213,18 +213,10 @@ pub unsafe extern "C" fn vstree_tree_build(
 fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiResult<vstree_tree> {
     let threads = Threads::new(params.threads)?;
     let t0 = Instant::now();
-    let samples = if mesh.is_point_cloud() {
-        SampleSet::from_cloud(mesh)?
-    } else {
-        SampleSet::from_mesh(mesh, params.sampling)?
-    };
+    let samples =
+        if mesh.is_point_cloud() { SampleSet::from_cloud(mesh)? } else { SampleSet::from_mesh(mesh, params.sampling)? };
     let t1 = Instant::now();
-    let tree = tree::build(
-        &samples,
-        &params.tree,
-        &threads,
-        &mut progress.stage(0.0, 0.8),
-    )?;
+    let tree = tree::build(&samples, &params.tree, &threads, &mut progress.stage(0.0, 0.8))?;
     let t2 = Instant::now();
     progress.report(0.8, "clustering")?;
     let clusters = cluster(&tree, &threads);
@@ -236,9 +228,7 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
     progress.report(0.9, "describing tree")?;
 
     // The T-layer, in node order, and where each node's frame (T-node) is in it.
-    let t_indices: Vec<usize> = (0..tree.nodes.len())
-        .filter(|&i| tree.nodes[i].kind == NodeKind::Transition)
-        .collect();
+    let t_indices: Vec<usize> = (0..tree.nodes.len()).filter(|&i| tree.nodes[i].kind == NodeKind::Transition).collect();
     let mut frame_to_t = vec![VSTREE_NO_INDEX; tree.frames.len()];
     for (k, &i) in t_indices.iter().enumerate() {
         if let Some(slot) = frame_to_t.get_mut(tree.nodes[i].frame as usize) {
@@ -247,10 +237,7 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
     }
     let t_of = |i: usize| match tree.nodes[i].kind {
         NodeKind::Volume => VSTREE_NO_INDEX,
-        _ => frame_to_t
-            .get(tree.nodes[i].frame as usize)
-            .copied()
-            .unwrap_or(VSTREE_NO_INDEX),
+        _ => frame_to_t.get(tree.nodes[i].frame as usize).copied().unwrap_or(VSTREE_NO_INDEX),
     };
     let mut node_cluster = vec![VSTREE_NO_INDEX; tree.nodes.len()];
     for (k, &leaf) in clusters.leaves.iter().enumerate() {
@@ -306,10 +293,7 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
         .iter()
         .map(|&c| match c {
             NO_CLUSTER => VSTREE_NO_INDEX,
-            c => clusters
-                .leaves
-                .get(c as usize)
-                .map_or(VSTREE_NO_INDEX, |&leaf| t_of(leaf as usize)),
+            c => clusters.leaves.get(c as usize).map_or(VSTREE_NO_INDEX, |&leaf| t_of(leaf as usize)),
         })
         .collect();
     let s = tree.stats();
@@ -350,14 +334,7 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
         seconds_tree: (t2 - t1).as_secs_f64(),
         seconds_total: 0.0,
     };
-    Ok(vstree_tree {
-        stats,
-        nodes,
-        t_nodes,
-        levels,
-        cluster_labels,
-        t_node_labels,
-    })
+    Ok(vstree_tree { stats, nodes, t_nodes, levels, cluster_labels, t_node_labels })
 }
 
 /// Each cluster's error: the figure the tree's split test compares with `error`.
@@ -374,8 +351,7 @@ fn cluster_errors(tree: &VsTree, leaves: &[u32]) -> Vec<f64> {
             }
             match tree.params.metric {
                 Metric::L2 => {
-                    let frame =
-                        (node.kind == NodeKind::Surface).then(|| &tree.frames[node.frame as usize]);
+                    let frame = (node.kind == NodeKind::Surface).then(|| &tree.frames[node.frame as usize]);
                     let x = tree::representative(node, frame, &stats, origin);
                     let absolute = stats.quadric_at(x - origin);
                     if scale > 0.0 {
@@ -415,12 +391,8 @@ unsafe fn tree_ref<'a>(tree: *const vstree_tree) -> FfiResult<&'a vstree_tree> {
 /// The tree's statistics, owned by `tree` (valid until it is freed; do not free it). NULL for
 /// NULL. Thread-safe.
 #[no_mangle]
-pub unsafe extern "C" fn vstree_tree_get_stats(
-    tree: *const vstree_tree,
-) -> *const vstree_tree_stats {
-    guard_or(std::ptr::null(), || {
-        unsafe { tree_opt(tree) }.map_or(std::ptr::null(), |t| &t.stats as *const _)
-    })
+pub unsafe extern "C" fn vstree_tree_get_stats(tree: *const vstree_tree) -> *const vstree_tree_stats {
+    guard_or(std::ptr::null(), || unsafe { tree_opt(tree) }.map_or(std::ptr::null(), |t| &t.stats as *const _))
 }
 
 /// Number of nodes (the length vstree_tree_copy_nodes() needs); 0 for NULL. Thread-safe.
@@ -432,27 +404,21 @@ pub unsafe extern "C" fn vstree_tree_node_count(tree: *const vstree_tree) -> usi
 /// Number of T-nodes (the length vstree_tree_copy_t_nodes() needs); 0 for NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_t_node_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || {
-        unsafe { tree_opt(tree) }.map_or(0, |t| t.t_nodes.len())
-    })
+    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.t_nodes.len()))
 }
 
 /// Number of levels, max_depth + 1 (the length vstree_tree_copy_levels() needs); 0 for NULL.
 /// Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_level_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || {
-        unsafe { tree_opt(tree) }.map_or(0, |t| t.levels.len())
-    })
+    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.levels.len()))
 }
 
 /// Number of labels: the vertex (point) count of the mesh the tree was built from (the length
 /// vstree_tree_copy_vertex_labels() needs); 0 for NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_vertex_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || {
-        unsafe { tree_opt(tree) }.map_or(0, |t| t.cluster_labels.len())
-    })
+    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.cluster_labels.len()))
 }
 
 /// Copies every node into the caller's array `out` of `capacity` elements, which must be at

@@ -20,10 +20,7 @@ const fn parse(text: &str) -> u32 {
     let mut value = 0u32;
     let mut i = 0;
     while i < bytes.len() {
-        assert!(
-            bytes[i].is_ascii_digit(),
-            "version component is not a number"
-        );
+        assert!(bytes[i].is_ascii_digit(), "version component is not a number");
         value = value * 10 + (bytes[i] - b'0') as u32;
         i += 1;
     }
@@ -64,13 +61,8 @@ mod tests {
 
     #[test]
     fn the_version_string_is_the_crate_version() {
-        let v = unsafe { CStr::from_ptr(vstree_version()) }
-            .to_str()
-            .unwrap();
+        let v = unsafe { CStr::from_ptr(vstree_version()) }.to_str().unwrap();
         assert_eq!(v, env!("CARGO_PKG_VERSION"));
-        assert_eq!(
-            v,
-            format!("{VSTREE_VERSION_MAJOR}.{VSTREE_VERSION_MINOR}.{VSTREE_VERSION_PATCH}")
-        );
+        assert_eq!(v, format!("{VSTREE_VERSION_MAJOR}.{VSTREE_VERSION_MINOR}.{VSTREE_VERSION_PATCH}"));
     }
 }
