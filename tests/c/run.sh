@@ -6,11 +6,16 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
-if ! command -v valgrind >/dev/null; then
-    echo "tests/c: installing valgrind from Debian"
+# Tools a fresh Debian machine may lack: command -> Debian package.
+missing=()
+for tool in valgrind:valgrind cmake:cmake pkg-config:pkg-config readelf:binutils cc:gcc c++:g++; do
+    command -v "${tool%%:*}" >/dev/null || missing+=("${tool#*:}")
+done
+if ((${#missing[@]})); then
+    echo "tests/c: installing ${missing[*]} from Debian"
     sudo=""
     [ "$(id -u)" -eq 0 ] || sudo="sudo"
-    $sudo apt-get update -qq && $sudo apt-get install -y -qq valgrind >/dev/null
+    $sudo apt-get update -qq && $sudo apt-get install -y -qq "${missing[@]}" >/dev/null
 fi
 
 prefix="$PWD/target/capi-install"
