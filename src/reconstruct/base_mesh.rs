@@ -241,6 +241,14 @@ mod tests {
     use super::*;
     use crate::topology::analyze;
 
+    /// Eight labels: the octant of each vertex.
+    fn octant_labels(mesh: &Mesh) -> Vec<u32> {
+        mesh.positions
+            .iter()
+            .map(|p| (p.x > 0.0) as u32 | ((p.y > 0.0) as u32) << 1 | ((p.z > 0.0) as u32) << 2)
+            .collect()
+    }
+
     #[test]
     fn collapsing_keeps_the_genus() {
         for (mesh, genus) in [
@@ -249,12 +257,7 @@ mod tests {
             (crate::shapes::double_torus(), 2),
         ] {
             // Eight clusters, the octants: collapse as far as topology allows.
-            let labels: Vec<u32> = mesh
-                .positions
-                .iter()
-                .map(|p| (p.x > 0.0) as u32 | ((p.y > 0.0) as u32) << 1 | ((p.z > 0.0) as u32) << 2)
-                .collect();
-            let base = cluster_at_t_layer(&mesh, &labels);
+            let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh));
             let r = analyze(&base.mesh);
             assert!(r.is_watertight(), "{r:?}");
             assert_eq!(r.genus(), Some(genus));
@@ -273,12 +276,7 @@ mod tests {
     fn labels_partition_a_sphere_into_clusters() {
         let mesh = crate::shapes::icosphere(1.0, 4);
         // Eight clusters: the octants.
-        let labels: Vec<u32> = mesh
-            .positions
-            .iter()
-            .map(|p| (p.x > 0.0) as u32 | ((p.y > 0.0) as u32) << 1 | ((p.z > 0.0) as u32) << 2)
-            .collect();
-        let base = cluster_at_t_layer(&mesh, &labels);
+        let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh));
         let r = analyze(&base.mesh);
         assert!(r.is_watertight() && r.genus() == Some(0));
         assert_eq!(base.mesh.positions.len(), 8, "one vertex per octant");
