@@ -4,6 +4,7 @@ the readers take (PLY ascii and both binary byte orders, OBJ, OFF, XYZ), and a f
 inputs. Small on purpose; libFuzzer grows its working corpus under target/ from these.
 Run: python3 fuzz/make_seeds.py (the output is committed)."""
 
+import math
 import os
 import struct
 
@@ -66,10 +67,25 @@ def seeds():
         body += bytes(i for f in F for i in f)
         return head + body
 
+    def sphere_cloud(n):
+        points = []
+        for i in range(n):
+            z = 1 - (2 * i + 1) / n
+            r = math.sqrt(1 - z * z)
+            a = math.pi * (3 - math.sqrt(5)) * i
+            points.append((r * math.cos(a), r * math.sin(a), z))
+        head = bytes([n, 0, 2]) + bytes(12)
+        body = b"".join(struct.pack("<3f", *p) for p in points)
+        body += bytes(int(v * 63) & 0xFF for p in points for v in p)
+        return head + body
+
     files["capi_arrays"] = {
         "floats": arrays(0, [0] * 12),
         "ints_normals_progress": arrays(1 | 2 | 4, [0, 0, 1, 0, 1, 0, 33, 24, 1, 0, 3, 1]),
         "cancel": arrays(1 | 4, [0, 0, 0, 0, 0, 0, 0, 24, 0, 0, 2, 0]),
+        # 120 points of a sphere with normals, no triangles: enough for vstree_reconstruct
+        # (its parameter bytes follow the arrays; none here, so the first choice of each).
+        "sphere_cloud": sphere_cloud(120),
     }
     return files
 

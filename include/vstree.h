@@ -85,6 +85,31 @@
 #define VSTREE_ABI_VERSION 0
 
 /**
+ * `orient` value: no orientation; estimated normals keep the arbitrary sign a plane fit gives
+ * them, and given normals are left as they are.
+ */
+#define VSTREE_ORIENTATION_UNORIENTED 0
+
+/**
+ * `orient` value: Hoppe's spanning-tree propagation; in each connected part of the neighbour
+ * graph, the normal at the highest point (largest z) points up (+z). For terrain and scans
+ * taken from above.
+ */
+#define VSTREE_ORIENTATION_PROPAGATE 1
+
+/**
+ * `orient` value: propagation, then each connected part keeps the sign most of its given
+ * normals already have. For given normals that are mostly right but locally inconsistent.
+ */
+#define VSTREE_ORIENTATION_PROPAGATE_MAJORITY 2
+
+/**
+ * `orient` value: propagation, then each connected part is turned to face outward (closed
+ * shapes of any genus come out outward; an open scan faces its convex side). The default.
+ */
+#define VSTREE_ORIENTATION_PROPAGATE_OUTWARD 3
+
+/**
  * The outcome of every fallible call. The numbers are part of the ABI: they never change and
  * are never reused. 13 to 31 are reserved for general statuses added later; 32 to 63 for the
  * statuses the reconstruction and normal-estimation entry points will need.
@@ -294,6 +319,13 @@ typedef int32_t vstree_label_kind;
  * same mesh at once; freeing it while another thread uses it is not allowed.
  */
 typedef struct vstree_mesh vstree_mesh;
+
+/**
+ * The output of vstree_reconstruct(): the reconstructed mesh and what was done. Opaque; freed
+ * with vstree_reconstruct_result_free(), which frees the mesh it holds too. Immutable: several
+ * threads may read it at once.
+ */
+typedef struct vstree_reconstruct_result vstree_reconstruct_result;
 
 /**
  * The output of vstree_simplify(): the simplified mesh and what was done. Opaque; freed with
@@ -678,6 +710,296 @@ typedef struct vstree_tree_level {
   uint64_t leaves;
 } vstree_tree_level;
 
+/**
+ * Parameters of vstree_estimate_normals(). Always start from vstree_normal_params_default()
+ * and change fields by name: it sets `struct_size`, and fields added in later versions then
+ * keep their defaults. Passing NULL means the defaults. The struct has no padding; every field
+ * is checked, and an out-of-range one fails the call with VSTREE_STATUS_INVALID_PARAMETER and
+ * a message naming it.
+ */
+typedef struct vstree_normal_params {
+  /**
+   * Size of this struct in bytes as the caller knows it; set by the _default() function.
+   */
+  uint32_t struct_size;
+  /**
+   * How normals get their signs: a VSTREE_ORIENTATION_* value. Default
+   * VSTREE_ORIENTATION_PROPAGATE_OUTWARD.
+   */
+  int32_t orient;
+  /**
+   * Neighbours per point the plane is fitted to (the point itself not counted), in [3, 256];
+   * default 16. More smooths noise but blurs thin features; time grows about linearly. A
+   * cloud with fewer points uses all its other points.
+   */
+  uint32_t neighbours;
+  /**
+   * 0 (default): normals the mesh already has are kept as they are, and only missing (all,
+   * or zero-length) ones are estimated. 1: given normals are re-oriented with `orient` too.
+   */
+  uint32_t reorient_given;
+  /**
+   * Worker threads: 0 = all cores (default), else at most 1024. Results do not depend on it.
+   */
+  uint32_t threads;
+} vstree_normal_params;
+
+/**
+ * What vstree_estimate_normals() did. The caller provides it: set `struct_size` to
+ * `sizeof(vstree_normals_report)` before the call; on success the library fills as many
+ * fields as both it and the caller know and sets `struct_size` to the bytes it filled. Later
+ * versions only add fields at the end.
+ */
+typedef struct vstree_normals_report {
+  /**
+   * In: the size of the caller's struct in bytes. Out: the bytes the library filled.
+   */
+  uint32_t struct_size;
+  /**
+   * 1 when an orientation was done (normals estimated with an `orient` other than
+   * VSTREE_ORIENTATION_UNORIENTED, or `reorient_given`), else 0 and the four orientation
+   * counts below are 0.
+   */
+  uint32_t oriented;
+  /**
+   * Normals that were estimated: all of them when the mesh had none, the zero-length ones
+   * when only some were, 0 when the given normals were kept or only re-oriented.
+   */
+  uint64_t estimated;
+  /**
+   * Neighbours per point actually used (fewer than asked for tiny clouds; 0 when nothing
+   * was estimated or oriented).
+   */
+  uint64_t neighbours;
+  /**
+   * Estimated points whose neighbourhood spans no plane (all equal or on a line); they took
+   * the normal of their nearest neighbour that has one.
+   */
+  uint64_t degenerate;
+  /**
+   * Connected parts of the neighbour graph, each oriented on its own.
+   */
+  uint64_t components;
+  /**
+   * Points in the largest connected part.
+   */
+  uint64_t largest_component;
+  /**
+   * Parts the outward test could not decide (no measurable flux): oriented by the +z rule.
+   */
+  uint64_t undecided_components;
+  /**
+   * Normals whose sign was changed by the orientation.
+   */
+  uint64_t flipped;
+} vstree_normals_report;
+
+/**
+ * Parameters of vstree_reconstruct(). Always start from vstree_reconstruct_params_default()
+ * and change fields by name: it sets `struct_size`, and fields added in later versions then
+ * keep their defaults. Passing NULL means the defaults. The struct has no padding; every field
+ * is checked, and an out-of-range one fails the call with VSTREE_STATUS_INVALID_PARAMETER and
+ * a message naming it.
+ *
+ * The tree is always a Volume-Surface Tree with the quadric (L2) metric; its fields are those
+ * of ::vstree_simplify_params with other defaults. The normal-estimation fields are those of
+ * ::vstree_normal_params; `threads` applies to the whole call.
+ */
+typedef struct vstree_reconstruct_params {
+  /**
+   * Size of this struct in bytes as the caller knows it; set by the _default() function.
+   */
+  uint32_t struct_size;
+  /**
+   * How estimated normals get their signs (VSTREE_ORIENTATION_* value); used only where the
+   * cloud has no normals, or for all of them with `reorient_given`. Default
+   * VSTREE_ORIENTATION_PROPAGATE_OUTWARD (reconstruction needs outward normals).
+   */
+  int32_t orient;
+  /**
+   * The tree's L2 bound: squared distance from a cluster's point to its samples' tangent
+   * planes, over the squared bounding-box diagonal. The de-noising control (larger =
+   * smoother, fewer details). Finite and > 0; default 1e-5.
+   */
+  double error;
+  /**
+   * Height-field test, normal cone (see ::vstree_simplify_params). Unitless, in [0, 1];
+   * default 0. Raising it makes the base mesh denser where curvature is high.
+   */
+  float d_a;
+  /**
+   * Height-field test, displacement (see ::vstree_simplify_params). Unitless, in [0, 1];
+   * default 1/6.
+   */
+  float d_d;
+  /**
+   * Deepest tree level, in [1, 30]; default 24.
+   */
+  uint32_t max_depth;
+  /**
+   * Most refinement levels, each multiplying the triangle count by 4; in [0, 12], default 6.
+   */
+  uint32_t max_levels;
+  /**
+   * Cells smaller than this fraction of the bounding-box diagonal are not split. In [0, 1);
+   * default 1e-7.
+   */
+  double min_cell_size;
+  /**
+   * Refinement stops once the RMS distance from the samples to the mesh, over the
+   * bounding-box diagonal, is at most this. Finite, >= 0; default 0 (refine until the
+   * quadtrees have no detail left or `max_levels`).
+   */
+  double target_distance;
+  /**
+   * A level that displaces fewer than this fraction of its new vertices ends refinement.
+   * Unitless, in [0, 1]; default 0.02.
+   */
+  double min_displaced;
+  /**
+   * No refinement level is started that would exceed this many triangles. In [1, 2^32 - 1];
+   * default 20,000,000.
+   */
+  uint32_t max_triangles;
+  /**
+   * The polygonisation grid is never finer than 2^`max_grid_depth` cells across the cloud's
+   * bounding cube. In [4, 20]; default 10.
+   */
+  uint32_t max_grid_depth;
+  /**
+   * Faces farther than this many grid cells from every sample are removed (open scans give
+   * open meshes). Finite, >= 0; default 0 (keep the closed surface).
+   */
+  float trim;
+  /**
+   * Neighbours per point for normal estimation, in [3, 256]; default 16.
+   */
+  uint32_t neighbours;
+  /**
+   * 0 (default): normals the cloud has are kept. 1: they are re-oriented with `orient`.
+   */
+  uint32_t reorient_given;
+  /**
+   * Worker threads: 0 = all cores (default), else at most 1024. Results do not depend on it.
+   */
+  uint32_t threads;
+} vstree_reconstruct_params;
+
+/**
+ * What a reconstruction did. Owned by its result (vstree_reconstruct_result_get_stats());
+ * later versions only add fields at the end, and `struct_size` says how many there are.
+ */
+typedef struct vstree_reconstruct_stats {
+  /**
+   * Size of this struct in bytes as the library filled it.
+   */
+  uint32_t struct_size;
+  /**
+   * Cells across the polygonisation grid of the base mesh (a power of two).
+   */
+  uint32_t grid_cells;
+  /**
+   * Genus of the base mesh M0, or -1 when M0 is not a closed manifold.
+   */
+  int32_t base_genus;
+  /**
+   * Refinement levels done (each splits every triangle in 4).
+   */
+  uint32_t levels;
+  /**
+   * Deepest level of the tree (the root is level 0).
+   */
+  uint32_t max_depth;
+  /**
+   * Neighbours per point used for normal estimation (0 when the cloud's normals were kept).
+   */
+  uint32_t normals_neighbours;
+  /**
+   * Normals estimated (0 when the cloud's own were all kept).
+   */
+  uint64_t normals_estimated;
+  /**
+   * Normals whose sign the orientation changed.
+   */
+  uint64_t normals_flipped;
+  /**
+   * Points of the input cloud.
+   */
+  uint64_t input_points;
+  /**
+   * Samples the tree was built from.
+   */
+  uint64_t samples;
+  /**
+   * Nodes of the tree, of every kind.
+   */
+  uint64_t nodes;
+  /**
+   * Transition nodes: one vertex of the base mesh M0 each, at most.
+   */
+  uint64_t t_nodes;
+  /**
+   * Triangles of the fine polygonisation clustered into M0.
+   */
+  uint64_t fine_triangles;
+  /**
+   * Vertices of the base mesh M0.
+   */
+  uint64_t base_vertices;
+  /**
+   * Triangles of the base mesh M0.
+   */
+  uint64_t base_triangles;
+  /**
+   * RMS distance from the samples to M0, over the bounding-box diagonal.
+   */
+  double base_error;
+  /**
+   * RMS distance from the samples to the final mesh (before trimming), over the diagonal.
+   */
+  double final_error;
+  /**
+   * Largest distance from a sample to the final mesh (before trimming), over the diagonal.
+   */
+  double final_max_error;
+  /**
+   * Triangles removed by trimming (0 when `trim` is 0).
+   */
+  uint64_t trimmed_triangles;
+  /**
+   * Vertices of the output mesh.
+   */
+  uint64_t output_vertices;
+  /**
+   * Triangles of the output mesh.
+   */
+  uint64_t output_triangles;
+  /**
+   * Seconds estimating normals (and taking the samples).
+   */
+  double seconds_normals;
+  /**
+   * Seconds building the tree.
+   */
+  double seconds_tree;
+  /**
+   * Seconds making the base mesh M0.
+   */
+  double seconds_base;
+  /**
+   * Seconds refining.
+   */
+  double seconds_refine;
+  /**
+   * Seconds trimming.
+   */
+  double seconds_trim;
+  /**
+   * Seconds in the whole library call, from parameter check to result.
+   */
+  double seconds_total;
+} vstree_reconstruct_stats;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -988,6 +1310,104 @@ const char *vstree_version(void);
  * written for. Thread-safe.
  */
 uint32_t vstree_abi_version(void);
+
+/**
+ * The default parameters, with `struct_size` set. Thread-safe; returns a value (nothing to
+ * free).
+ */
+struct vstree_normal_params vstree_normal_params_default(void);
+
+/**
+ * Estimates and orients normals: gives a copy of `mesh` (its positions and triangles) whose
+ * normals are the given ones where kept and estimated ones where missing. Triangles are
+ * ignored by the estimation: the vertices are treated as a point cloud (a plane fitted to each
+ * point's `params->neighbours` nearest neighbours, then signs chosen by `params->orient`).
+ *
+ * - A mesh without normals, or whose normals are all zero: every normal is estimated.
+ * - A mesh with normals: they are kept (then the copy is equal to `mesh`), or re-oriented
+ *   when `params->reorient_given` is 1; zero-length ones are estimated and take the sign of
+ *   their neighbours.
+ *
+ * Estimated and re-oriented normals are unit length. Mesh handles are immutable, so `mesh` is
+ * never changed: on success a new mesh is written to `*out_mesh` and belongs to the caller,
+ * who frees it with vstree_mesh_free() (and may free `mesh` at once). `out_report` may be
+ * NULL; if not, set its `struct_size` first (see ::vstree_normals_report); it is written on
+ * success only. `params` NULL means the defaults. `progress` (may be NULL) is called with
+ * `user_data` from the calling thread; returning 0 from it cancels.
+ *
+ * Fails with VSTREE_STATUS_NULL_POINTER (`mesh`, `out_mesh`), VSTREE_STATUS_INVALID_ARGUMENT
+ * (bad `params->struct_size` or `out_report->struct_size`), VSTREE_STATUS_INVALID_PARAMETER,
+ * VSTREE_STATUS_INVALID_INPUT (fewer than 3 points, all points equal or on one line),
+ * VSTREE_STATUS_OUT_OF_MEMORY or VSTREE_STATUS_CANCELLED; nothing is written then.
+ * Thread-safe.
+ */
+vstree_status vstree_estimate_normals(const struct vstree_mesh *mesh,
+                                      const struct vstree_normal_params *params,
+                                      vstree_progress_fn progress,
+                                      void *user_data,
+                                      struct vstree_mesh **out_mesh,
+                                      struct vstree_normals_report *out_report);
+
+/**
+ * The default parameters, with `struct_size` set. Thread-safe; returns a value (nothing to
+ * free).
+ */
+struct vstree_reconstruct_params vstree_reconstruct_params_default(void);
+
+/**
+ * Reconstructs a triangle mesh from the points of `cloud` (its triangles, if any, are
+ * ignored): normals are estimated where the cloud has none (all, or zero-length ones), the
+ * VS-Tree of the points is built, its T-nodes give a coarse closed base mesh, which is
+ * refined by the quadtrees below them until it is close enough to the points; with
+ * `params->trim` > 0, faces far from every point are removed at the end. The output has
+ * unit per-vertex normals and counter-clockwise triangles seen from outside.
+ *
+ * `params` NULL means the defaults. `progress` (may be NULL) is called with `user_data` from
+ * the calling thread as the work goes; returning 0 from it cancels. On success the new result
+ * is written to `*out_result` and belongs to the caller, who frees it with
+ * vstree_reconstruct_result_free(); the caller keeps ownership of `cloud`, which is not
+ * changed. On failure nothing is written and nothing is left allocated.
+ *
+ * Fails with VSTREE_STATUS_NULL_POINTER, VSTREE_STATUS_INVALID_ARGUMENT (bad
+ * `params->struct_size`), VSTREE_STATUS_INVALID_PARAMETER, VSTREE_STATUS_INVALID_INPUT (fewer
+ * than 10 points, points all on a line, normals so inconsistent that no surface is found),
+ * VSTREE_STATUS_TOO_LARGE (the surface needs more grid cells than the library allows) or
+ * VSTREE_STATUS_CANCELLED. Thread-safe: calls on different clouds, or on the same cloud, may
+ * run at once from different threads.
+ */
+vstree_status vstree_reconstruct(const struct vstree_mesh *cloud,
+                                 const struct vstree_reconstruct_params *params,
+                                 vstree_progress_fn progress,
+                                 void *user_data,
+                                 struct vstree_reconstruct_result **out_result);
+
+/**
+ * The reconstructed mesh, owned by `result`: valid until vstree_reconstruct_result_free(result),
+ * and never to be passed to vstree_mesh_free(). Use it with every `const vstree_mesh *`
+ * function (counts, copies, vstree_mesh_save(), vstree_simplify()). NULL for NULL.
+ */
+const struct vstree_mesh *vstree_reconstruct_result_get_mesh(const struct vstree_reconstruct_result *result);
+
+/**
+ * The statistics of the reconstruction, owned by `result` (valid until it is freed; do not
+ * free it). NULL for NULL.
+ */
+const struct vstree_reconstruct_stats *vstree_reconstruct_result_get_stats(const struct vstree_reconstruct_result *result);
+
+/**
+ * Frees a result of vstree_reconstruct() and the mesh and statistics it owns. NULL is a
+ * no-op.
+ */
+void vstree_reconstruct_result_free(struct vstree_reconstruct_result *result);
+
+/**
+ * Moves the mesh out of a reconstruction result into its own handle: `*out_mesh` gets a new
+ * mesh the caller frees with vstree_mesh_free(), and `result` is freed (it must not be used
+ * again, whatever the status). Fails with VSTREE_STATUS_NULL_POINTER; when `out_mesh` is NULL
+ * the result is left alone.
+ */
+vstree_status vstree_reconstruct_result_take_mesh(struct vstree_reconstruct_result *result,
+                                                  struct vstree_mesh **out_mesh);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -13,6 +13,10 @@
  *       return true;  // false cancels: vstree::error with VSTREE_STATUS_CANCELLED
  *   });
  *   r.mesh().save("bunny-simplified.ply");
+ *
+ *   vstree::mesh scan = vstree::mesh::load("scan.xyz");        // points, no normals
+ *   vstree::reconstruct_result s = vstree::reconstruct(scan);  // normals estimated inside
+ *   s.mesh().save("scan-surface.ply");
  * \endcode
  *
  * Thread safety is the C API's: objects are immutable once made, so const use from several
@@ -288,6 +292,64 @@ public:
 private:
   detail::handle<vstree_tree, vstree_tree_free> h_;
 };
+
+/** The default reconstruction parameters (with `struct_size` set): change fields by name. */
+inline vstree_reconstruct_params default_reconstruct_params() {
+  return vstree_reconstruct_params_default();
+}
+
+/** The default normal-estimation parameters (with `struct_size` set). */
+inline vstree_normal_params default_normal_params() { return vstree_normal_params_default(); }
+
+/** What vstree::reconstruct() returns: the reconstructed mesh and statistics. */
+class reconstruct_result {
+public:
+  explicit reconstruct_result(vstree_reconstruct_result *r) noexcept : h_(r) {}
+  /** The reconstructed mesh, valid while this result lives. */
+  mesh_view mesh() const noexcept {
+    return mesh_view(vstree_reconstruct_result_get_mesh(h_.get()));
+  }
+  /** Statistics: normals, tree, base mesh, refinement, errors, timings. */
+  const vstree_reconstruct_stats &stats() const noexcept {
+    return *vstree_reconstruct_result_get_stats(h_.get());
+  }
+  /** Moves the mesh out; this result is empty afterwards. */
+  vstree::mesh take_mesh() {
+    vstree_mesh *m = nullptr;
+    detail::check(vstree_reconstruct_result_take_mesh(h_.release(), &m));
+    return vstree::mesh(m);
+  }
+
+private:
+  detail::handle<vstree_reconstruct_result, vstree_reconstruct_result_free> h_;
+};
+
+/** Reconstructs a triangle mesh from the points of `cloud` (see vstree_reconstruct()). */
+inline reconstruct_result reconstruct(
+    mesh_view cloud, const vstree_reconstruct_params &params = default_reconstruct_params(),
+    const progress_fn &progress = progress_fn()) {
+  vstree_reconstruct_result *r = nullptr;
+  detail::with_progress(progress, [&](vstree_progress_fn cb, void *user) {
+    return vstree_reconstruct(cloud.get(), &params, cb, user, &r);
+  });
+  return reconstruct_result(r);
+}
+
+/** A copy of `input` with normals estimated where missing (or re-oriented, with
+ * `params.reorient_given`); see vstree_estimate_normals(). `report`, if given, is filled. */
+inline mesh estimate_normals(mesh_view input,
+                             const vstree_normal_params &params = default_normal_params(),
+                             const progress_fn &progress = progress_fn(),
+                             vstree_normals_report *report = nullptr) {
+  vstree_mesh *m = nullptr;
+  if (report != nullptr) {
+    report->struct_size = sizeof(vstree_normals_report);
+  }
+  detail::with_progress(progress, [&](vstree_progress_fn cb, void *user) {
+    return vstree_estimate_normals(input.get(), &params, cb, user, &m, report);
+  });
+  return mesh(m);
+}
 
 /** The library's version string, e.g. "0.1.0". */
 inline std::string version() { return vstree_version(); }

@@ -1,6 +1,7 @@
 //! The C API from arrays, as hosts call it: fuzz-chosen vertices (wild floats or small
 //! integers), normals, triangle indices, parameter fields (struct_size included), buffer
-//! capacities, label kinds and the progress report at which to cancel. The arrays always hold
+//! capacities, label kinds and the progress report at which to cancel, then (bytes after the
+//! arrays) reconstruction and normal-estimation parameters. The arrays always hold
 //! what the counts say (the caller's side of the contract); everything else is arbitrary.
 //! Every call must return a status, never VSTREE_STATUS_INTERNAL, and outputs must be
 //! consistent with their statistics.
@@ -9,6 +10,8 @@ use libfuzzer_sys::fuzz_target;
 use std::ffi::{c_char, c_void};
 use std::ptr::{null, null_mut};
 use vstree::ffi::mesh::*;
+use vstree::ffi::normals::*;
+use vstree::ffi::reconstruct::*;
 use vstree::ffi::simplify::*;
 use vstree::ffi::tree::*;
 use vstree::ffi::vstree_status;
@@ -177,6 +180,84 @@ fuzz_target!(|data: &[u8]| {
             vstree_tree_free(tree);
         } else {
             assert!(tree.is_null());
+        }
+
+        // Reconstruction and normal estimation, with parameters from the bytes after the
+        // arrays (zeros, i.e. the first choice of each, when the input ends there). Grid depth
+        // and levels stay small so a run never nears the fuzzer's timeout.
+        let mut r = vstree_reconstruct_params_default();
+        r.struct_size = [80, 80, 80, 0, 79, 4096][b.u8() as usize % 6];
+        r.orient = [3, 0, 1, 2, 4, -1][b.u8() as usize % 6];
+        r.error = [1e-5, 1e-3, 0.0, f64::NAN, 1e-9][b.u8() as usize % 5];
+        r.max_levels = [1, 0, 2, 13][b.u8() as usize % 4];
+        r.max_grid_depth = [5, 4, 6, 3, 21][b.u8() as usize % 5];
+        r.trim = [0.0, 1.5, -1.0, f32::NAN][b.u8() as usize % 4];
+        r.target_distance = [0.0, 1e-3, -1.0][b.u8() as usize % 3];
+        r.neighbours = [16, 3, 8, 0, 257][b.u8() as usize % 5];
+        r.reorient_given = u32::from(b.u8() % 3);
+        r.threads = [0, 2000][b.u8() as usize % 2];
+        let mut q = vstree_normal_params_default();
+        q.struct_size = [20, 20, 20, 0, 19, 21][b.u8() as usize % 6];
+        q.orient = r.orient;
+        q.neighbours = r.neighbours;
+        q.reorient_given = r.reorient_given;
+        q.threads = r.threads;
+        let with_report = b.u8();
+
+        let mut stop = Stop {
+            calls: 0,
+            at: stop_at,
+        };
+        let user = (&mut stop as *mut Stop).cast();
+        let mut out = null_mut();
+        let mut report = vstree_normals_report {
+            struct_size: [64u32, 0, 4096][usize::from(with_report % 3)],
+            ..Default::default()
+        };
+        let report_ptr = if with_report & 4 != 0 {
+            null_mut()
+        } else {
+            &mut report as *mut _
+        };
+        if status_ok(vstree_estimate_normals(
+            mesh, &q, cb, user, &mut out, report_ptr,
+        )) {
+            assert_eq!(
+                vstree_mesh_vertex_count(out),
+                vstree_mesh_vertex_count(mesh)
+            );
+            assert_eq!(vstree_mesh_has_normals(out), 1);
+            assert!(
+                report_ptr.is_null() || report.estimated as usize <= vstree_mesh_vertex_count(mesh)
+            );
+            vstree_mesh_free(out);
+        } else {
+            assert!(out.is_null());
+        }
+
+        let mut stop = Stop {
+            calls: 0,
+            at: stop_at,
+        };
+        let user = (&mut stop as *mut Stop).cast();
+        let mut result = null_mut();
+        if status_ok(vstree_reconstruct(mesh, &r, cb, user, &mut result)) {
+            let s = &*vstree_reconstruct_result_get_stats(result);
+            let m = vstree_reconstruct_result_get_mesh(result);
+            assert_eq!(s.output_vertices as usize, vstree_mesh_vertex_count(m));
+            assert_eq!(s.output_triangles as usize, vstree_mesh_triangle_count(m));
+            let mut idx = vec![0u32; vstree_mesh_triangle_count(m) * 3];
+            assert!(status_ok(vstree_mesh_copy_triangles(
+                m,
+                idx.as_mut_ptr(),
+                idx.len()
+            )));
+            assert!(idx
+                .iter()
+                .all(|&i| (i as usize) < vstree_mesh_vertex_count(m)));
+            vstree_reconstruct_result_free(result);
+        } else {
+            assert!(result.is_null());
         }
         vstree_mesh_free(mesh);
     }

@@ -14,7 +14,8 @@
 //!
 //! One idea per file: [`arrays`] checks caller arrays, [`params`] reads versioned structs,
 //! [`progress`] adapts the C callback, [`version`] holds the version, [`mesh`], [`simplify`] and
-//! [`tree`] are the three handles.
+//! [`tree`] are the three handles; [`normals`] estimates normals into a new mesh, and
+//! [`reconstruct`] is the fourth handle.
 // The C names are the Rust names, so a symbol in the header can be grepped for here.
 #![allow(non_camel_case_types)]
 // Each function documents what its pointer arguments must be (a handle from a named call, or an
@@ -28,6 +29,9 @@ pub mod progress;
 pub mod simplify;
 pub mod tree;
 pub mod version;
+// Added in 0.1 after the three handles above: placed last so the header only grows at its end.
+pub mod normals;
+pub mod reconstruct;
 
 use crate::error::Error;
 use std::cell::RefCell;

@@ -591,9 +591,327 @@ static void trees(const vstree_mesh *mesh) {
   cancel_at_every_report("vstree_tree_build", tree_call, mesh, free_tree);
 }
 
+/* ---- reconstruction and normal estimation ---- */
+
+#define SENTINEL_RECONSTRUCT ((vstree_reconstruct_result *)(uintptr_t)0x10)
+
+/* Small enough to run quickly under valgrind. */
+static vstree_reconstruct_params quick_reconstruct_params(void) {
+  vstree_reconstruct_params p = vstree_reconstruct_params_default();
+  p.max_levels = 2;
+  p.max_grid_depth = 6;
+  return p;
+}
+
+static vstree_status reconstruct_call(const vstree_mesh *m, stopper *s, void **out) {
+  vstree_reconstruct_result *r = SENTINEL_RECONSTRUCT;
+  vstree_reconstruct_params p = quick_reconstruct_params();
+  vstree_status status = vstree_reconstruct(m, &p, stop_cb, s, &r);
+  *out = r;
+  return status;
+}
+
+static vstree_status normals_call(const vstree_mesh *m, stopper *s, void **out) {
+  vstree_mesh *n = SENTINEL_MESH;
+  vstree_normals_report report;
+  vstree_status status;
+  memset(&report, 0x5a, sizeof report);
+  report.struct_size = sizeof report;
+  status = vstree_estimate_normals(m, NULL, stop_cb, s, &n, &report);
+  if (status != VSTREE_STATUS_OK) {
+    CHECK(report.struct_size == sizeof report && report.estimated == 0x5a5a5a5a5a5a5a5aULL);
+  }
+  *out = n;
+  return status;
+}
+
+static void free_reconstruct(void *r) {
+  vstree_reconstruct_result_free((vstree_reconstruct_result *)r);
+}
+static void free_mesh(void *m) { vstree_mesh_free((vstree_mesh *)m); }
+
+#define RSPOILER(name, field, value)                                                           \
+  static void name(vstree_reconstruct_params *q) { q->field = value; }
+RSPOILER(r_orient_neg, orient, -1)
+RSPOILER(r_orient_big, orient, 4)
+RSPOILER(r_error_zero, error, 0.0)
+RSPOILER(r_error_nan, error, NAN)
+RSPOILER(r_error_inf, error, INFINITY)
+RSPOILER(r_d_a_big, d_a, 1.5f)
+RSPOILER(r_d_a_nan, d_a, NAN)
+RSPOILER(r_d_d_neg, d_d, -0.5f)
+RSPOILER(r_depth_zero, max_depth, 0)
+RSPOILER(r_depth_big, max_depth, 31)
+RSPOILER(r_levels_big, max_levels, 13)
+RSPOILER(r_levels_huge, max_levels, UINT32_MAX)
+RSPOILER(r_cell_one, min_cell_size, 1.0)
+RSPOILER(r_cell_nan, min_cell_size, NAN)
+RSPOILER(r_target_neg, target_distance, -1e-3)
+RSPOILER(r_target_nan, target_distance, NAN)
+RSPOILER(r_target_inf, target_distance, INFINITY)
+RSPOILER(r_displaced_big, min_displaced, 1.5)
+RSPOILER(r_displaced_nan, min_displaced, NAN)
+RSPOILER(r_triangles_zero, max_triangles, 0)
+RSPOILER(r_grid_small, max_grid_depth, 3)
+RSPOILER(r_grid_big, max_grid_depth, 21)
+RSPOILER(r_trim_neg, trim, -1.0f)
+RSPOILER(r_trim_nan, trim, NAN)
+RSPOILER(r_neighbours_small, neighbours, 2)
+RSPOILER(r_neighbours_big, neighbours, 257)
+RSPOILER(r_reorient_two, reorient_given, 2)
+RSPOILER(r_threads_big, threads, 1025)
+RSPOILER(r_threads_huge, threads, UINT32_MAX)
+RSPOILER(r_size_zero, struct_size, 0)
+RSPOILER(r_size_short, struct_size, 8)
+RSPOILER(r_size_long, struct_size, 4096)
+
+#define NSPOILER(name, field, value)                                                           \
+  static void name(vstree_normal_params *q) { q->field = value; }
+NSPOILER(n_orient_neg, orient, -1)
+NSPOILER(n_orient_big, orient, 4)
+NSPOILER(n_neighbours_zero, neighbours, 0)
+NSPOILER(n_neighbours_big, neighbours, 257)
+NSPOILER(n_neighbours_huge, neighbours, UINT32_MAX)
+NSPOILER(n_reorient_two, reorient_given, 2)
+NSPOILER(n_threads_big, threads, 1025)
+NSPOILER(n_size_zero, struct_size, 0)
+NSPOILER(n_size_short, struct_size, 19)
+NSPOILER(n_size_long, struct_size, 4096)
+
+/* Every directed edge (a, b) has its twin (b, a) exactly once: closed, consistently oriented. */
+static int compare_u64(const void *a, const void *b) {
+  uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+  return x < y ? -1 : x > y;
+}
+
+static int watertight(const uint32_t *tri, size_t t, size_t n) {
+  uint64_t *edges = (uint64_t *)malloc(3 * t * sizeof *edges);
+  size_t k, ok = 1;
+  for (k = 0; k < 3 * t; k++) {
+    uint32_t a = tri[k], b = tri[k % 3 == 2 ? k - 2 : k + 1];
+    ok &= a < n && b < n && a != b;
+    edges[k] = ((uint64_t)a << 32) | b;
+  }
+  qsort(edges, 3 * t, sizeof *edges, compare_u64);
+  for (k = 0; ok && k < 3 * t; k++) {
+    uint64_t twin = (edges[k] << 32) | (edges[k] >> 32);
+    ok &= (k + 1 == 3 * t || edges[k + 1] != edges[k]) &&
+          bsearch(&twin, edges, 3 * t, sizeof *edges, compare_u64) != NULL;
+  }
+  free(edges);
+  return (int)ok;
+}
+
+static void reconstruction(const vstree_mesh *cloud, const vstree_mesh *cloud_no_normals) {
+  struct bad {
+    const char *needle;
+    vstree_status expected;
+    void (*spoil)(vstree_reconstruct_params *);
+  } table[] = {
+      {"`orient`", VSTREE_STATUS_INVALID_PARAMETER, r_orient_neg},
+      {"`orient`", VSTREE_STATUS_INVALID_PARAMETER, r_orient_big},
+      {"`error`", VSTREE_STATUS_INVALID_PARAMETER, r_error_zero},
+      {"`error`", VSTREE_STATUS_INVALID_PARAMETER, r_error_nan},
+      {"`error`", VSTREE_STATUS_INVALID_PARAMETER, r_error_inf},
+      {"`d_a`", VSTREE_STATUS_INVALID_PARAMETER, r_d_a_big},
+      {"`d_a`", VSTREE_STATUS_INVALID_PARAMETER, r_d_a_nan},
+      {"`d_d`", VSTREE_STATUS_INVALID_PARAMETER, r_d_d_neg},
+      {"`max_depth`", VSTREE_STATUS_INVALID_PARAMETER, r_depth_zero},
+      {"`max_depth`", VSTREE_STATUS_INVALID_PARAMETER, r_depth_big},
+      {"`max_levels`", VSTREE_STATUS_INVALID_PARAMETER, r_levels_big},
+      {"`max_levels`", VSTREE_STATUS_INVALID_PARAMETER, r_levels_huge},
+      {"`min_cell_size`", VSTREE_STATUS_INVALID_PARAMETER, r_cell_one},
+      {"`min_cell_size`", VSTREE_STATUS_INVALID_PARAMETER, r_cell_nan},
+      {"`target_distance`", VSTREE_STATUS_INVALID_PARAMETER, r_target_neg},
+      {"`target_distance`", VSTREE_STATUS_INVALID_PARAMETER, r_target_nan},
+      {"`target_distance`", VSTREE_STATUS_INVALID_PARAMETER, r_target_inf},
+      {"`min_displaced`", VSTREE_STATUS_INVALID_PARAMETER, r_displaced_big},
+      {"`min_displaced`", VSTREE_STATUS_INVALID_PARAMETER, r_displaced_nan},
+      {"`max_triangles`", VSTREE_STATUS_INVALID_PARAMETER, r_triangles_zero},
+      {"`max_grid_depth`", VSTREE_STATUS_INVALID_PARAMETER, r_grid_small},
+      {"`max_grid_depth`", VSTREE_STATUS_INVALID_PARAMETER, r_grid_big},
+      {"`trim`", VSTREE_STATUS_INVALID_PARAMETER, r_trim_neg},
+      {"`trim`", VSTREE_STATUS_INVALID_PARAMETER, r_trim_nan},
+      {"`neighbours`", VSTREE_STATUS_INVALID_PARAMETER, r_neighbours_small},
+      {"`neighbours`", VSTREE_STATUS_INVALID_PARAMETER, r_neighbours_big},
+      {"`reorient_given`", VSTREE_STATUS_INVALID_PARAMETER, r_reorient_two},
+      {"`threads`", VSTREE_STATUS_INVALID_PARAMETER, r_threads_big},
+      {"`threads`", VSTREE_STATUS_INVALID_PARAMETER, r_threads_huge},
+      {"params->struct_size", VSTREE_STATUS_INVALID_ARGUMENT, r_size_zero},
+      {"params->struct_size", VSTREE_STATUS_INVALID_ARGUMENT, r_size_short},
+      {"newer vstree.h", VSTREE_STATUS_INVALID_ARGUMENT, r_size_long},
+  };
+  vstree_reconstruct_params d = vstree_reconstruct_params_default();
+  vstree_reconstruct_params p = quick_reconstruct_params();
+  vstree_reconstruct_result *r = SENTINEL_RECONSTRUCT;
+  vstree_mesh *taken = SENTINEL_MESH, *few = NULL;
+  const vstree_reconstruct_stats *s;
+  const vstree_mesh *out;
+  float points[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+  size_t k;
+
+  CHECK(d.struct_size == sizeof(vstree_reconstruct_params));
+  CHECK(d.orient == VSTREE_ORIENTATION_PROPAGATE_OUTWARD && d.reorient_given == 0);
+  CHECK(d.error > 0 && d.max_levels <= 12 && d.max_grid_depth >= 4 && d.max_grid_depth <= 20);
+  CHECK(d.neighbours >= 3 && d.threads == 0 && d.trim == 0 && d.max_triangles > 0);
+
+  EXPECT(VSTREE_STATUS_NULL_POINTER, "`out_result`",
+         vstree_reconstruct(cloud, NULL, NULL, NULL, NULL));
+  EXPECT(VSTREE_STATUS_NULL_POINTER, "`cloud`", vstree_reconstruct(NULL, NULL, NULL, NULL, &r));
+  EXPECT(VSTREE_STATUS_OK, NULL, vstree_mesh_create(points, 5, NULL, NULL, 0, &few));
+  EXPECT(VSTREE_STATUS_INVALID_INPUT, "5 points", vstree_reconstruct(few, NULL, NULL, NULL, &r));
+  EXPECT(VSTREE_STATUS_INVALID_INPUT, "5 points", vstree_reconstruct(few, &p, NULL, NULL, &r));
+  vstree_mesh_free(few);
+  for (k = 0; k < sizeof table / sizeof table[0]; k++) {
+    vstree_reconstruct_params q = quick_reconstruct_params();
+    table[k].spoil(&q);
+    EXPECT(table[k].expected, table[k].needle, vstree_reconstruct(cloud, &q, NULL, NULL, &r));
+  }
+  CHECK(r == SENTINEL_RECONSTRUCT);
+  CHECK(vstree_reconstruct_result_get_mesh(NULL) == NULL);
+  CHECK(vstree_reconstruct_result_get_stats(NULL) == NULL);
+  vstree_reconstruct_result_free(NULL);
+  EXPECT(VSTREE_STATUS_NULL_POINTER, "`result`",
+         vstree_reconstruct_result_take_mesh(NULL, &taken));
+  CHECK(taken == SENTINEL_MESH);
+
+  /* Good input: a torus cloud without normals gives a closed genus-1 surface. */
+  EXPECT(VSTREE_STATUS_OK, NULL, vstree_reconstruct(cloud_no_normals, &p, NULL, NULL, &r));
+  s = vstree_reconstruct_result_get_stats(r);
+  out = vstree_reconstruct_result_get_mesh(r);
+  CHECK(s != NULL && out != NULL);
+  if (s != NULL && out != NULL) {
+    size_t n = vstree_mesh_vertex_count(out), t = vstree_mesh_triangle_count(out);
+    uint32_t *tri = (uint32_t *)malloc(3 * t * sizeof *tri + 1);
+    CHECK(s->struct_size == sizeof(vstree_reconstruct_stats));
+    CHECK(n > 0 && t > 0 && vstree_mesh_has_normals(out) == 1);
+    CHECK(s->output_vertices == n && s->output_triangles == t);
+    CHECK(s->input_points == vstree_mesh_vertex_count(cloud_no_normals));
+    CHECK(s->normals_estimated == s->input_points && s->normals_neighbours == d.neighbours);
+    CHECK(s->samples == s->input_points && s->t_nodes > 0 && s->nodes > s->t_nodes);
+    CHECK(s->base_genus == 1 && s->base_vertices > 0 && s->base_triangles == 2 * s->base_vertices);
+    CHECK(s->levels <= p.max_levels && s->grid_cells >= 2 && s->grid_cells <= 64u);
+    CHECK(t == 2 * n); /* Euler: a closed genus-1 surface */
+    CHECK(s->final_error > 0 && s->final_error <= s->final_max_error && s->final_error < 1e-2);
+    CHECK(s->trimmed_triangles == 0);
+    CHECK(s->seconds_total >= s->seconds_tree && s->seconds_tree >= 0 && s->seconds_refine >= 0);
+    EXPECT(VSTREE_STATUS_OK, NULL, vstree_mesh_copy_triangles(out, tri, 3 * t));
+    CHECK(watertight(tri, t, n));
+    free(tri);
+  }
+  EXPECT(VSTREE_STATUS_NULL_POINTER, "`out_mesh`", vstree_reconstruct_result_take_mesh(r, NULL));
+  EXPECT(VSTREE_STATUS_OK, NULL, vstree_reconstruct_result_take_mesh(r, &taken));
+  CHECK(taken != SENTINEL_MESH && vstree_mesh_triangle_count(taken) > 0);
+  vstree_mesh_free(taken);
+
+  /* The cloud's own normals are kept; trimming runs. */
+  p.trim = 1.5f;
+  r = NULL;
+  EXPECT(VSTREE_STATUS_OK, NULL, vstree_reconstruct(cloud, &p, NULL, NULL, &r));
+  CHECK(r != NULL && vstree_reconstruct_result_get_stats(r)->normals_estimated == 0);
+  CHECK(r != NULL && vstree_reconstruct_result_get_stats(r)->output_triangles > 0);
+  vstree_reconstruct_result_free(r);
+
+  cancel_at_every_report("vstree_reconstruct", reconstruct_call, cloud_no_normals,
+                         free_reconstruct);
+}
+
+static void normal_estimation(const torus *tor, const vstree_mesh *cloud_no_normals,
+                              const vstree_mesh *mesh_no_normals) {
+  struct bad {
+    const char *needle;
+    vstree_status expected;
+    void (*spoil)(vstree_normal_params *);
+  } table[] = {
+      {"`orient`", VSTREE_STATUS_INVALID_PARAMETER, n_orient_neg},
+      {"`orient`", VSTREE_STATUS_INVALID_PARAMETER, n_orient_big},
+      {"`neighbours`", VSTREE_STATUS_INVALID_PARAMETER, n_neighbours_zero},
+      {"`neighbours`", VSTREE_STATUS_INVALID_PARAMETER, n_neighbours_big},
+      {"`neighbours`", VSTREE_STATUS_INVALID_PARAMETER, n_neighbours_huge},
+      {"`reorient_given`", VSTREE_STATUS_INVALID_PARAMETER, n_reorient_two},
+      {"`threads`", VSTREE_STATUS_INVALID_PARAMETER, n_threads_big},
+      {"params->struct_size", VSTREE_STATUS_INVALID_ARGUMENT, n_size_zero},
+      {"params->struct_size", VSTREE_STATUS_INVALID_ARGUMENT, n_size_short},
+      {"newer vstree.h", VSTREE_STATUS_INVALID_ARGUMENT, n_size_long},
+  };
+  vstree_normal_params d = vstree_normal_params_default();
+  vstree_normals_report report;
+  vstree_mesh *out = SENTINEL_MESH, *two = NULL, *line = NULL;
+  float points[30];
+  size_t k, n = vstree_mesh_vertex_count(cloud_no_normals);
+
+  CHECK(d.struct_size == sizeof(vstree_normal_params));
+  CHECK(d.orient == VSTREE_ORIENTATION_PROPAGATE_OUTWARD && d.neighbours >= 3);
+  CHECK(d.reorient_given == 0 && d.threads == 0);
+
+  memset(&report, 0, sizeof report);
+  report.struct_size = sizeof report;
+  EXPECT(VSTREE_STATUS_NULL_POINTER, "`out_mesh`",
+         vstree_estimate_normals(cloud_no_normals, NULL, NULL, NULL, NULL, &report));
+  EXPECT(VSTREE_STATUS_NULL_POINTER, "`mesh`",
+         vstree_estimate_normals(NULL, NULL, NULL, NULL, &out, &report));
+  for (k = 0; k < 10; k++) {
+    points[3 * k] = (float)k;
+    points[3 * k + 1] = 2.0f * (float)k;
+    points[3 * k + 2] = -(float)k;
+  }
+  EXPECT(VSTREE_STATUS_OK, NULL, vstree_mesh_create(points, 2, NULL, NULL, 0, &two));
+  EXPECT(VSTREE_STATUS_INVALID_INPUT, "2 points",
+         vstree_estimate_normals(two, NULL, NULL, NULL, &out, NULL));
+  EXPECT(VSTREE_STATUS_OK, NULL, vstree_mesh_create(points, 10, NULL, NULL, 0, &line));
+  EXPECT(VSTREE_STATUS_INVALID_INPUT, NULL,
+         vstree_estimate_normals(line, NULL, NULL, NULL, &out, NULL));
+  vstree_mesh_free(two);
+  vstree_mesh_free(line);
+  for (k = 0; k < sizeof table / sizeof table[0]; k++) {
+    vstree_normal_params q = vstree_normal_params_default();
+    table[k].spoil(&q);
+    EXPECT(table[k].expected, table[k].needle,
+           vstree_estimate_normals(cloud_no_normals, &q, NULL, NULL, &out, NULL));
+  }
+  report.struct_size = 0;
+  EXPECT(VSTREE_STATUS_INVALID_ARGUMENT, "out_report->struct_size",
+         vstree_estimate_normals(cloud_no_normals, NULL, NULL, NULL, &out, &report));
+  report.struct_size = 12;
+  EXPECT(VSTREE_STATUS_INVALID_ARGUMENT, "out_report->struct_size",
+         vstree_estimate_normals(cloud_no_normals, NULL, NULL, NULL, &out, &report));
+  CHECK(out == SENTINEL_MESH && report.struct_size == 12 && report.estimated == 0);
+
+  /* Good input: a new cloud with outward normals; the input is unchanged. */
+  report.struct_size = sizeof report;
+  EXPECT(VSTREE_STATUS_OK, NULL,
+         vstree_estimate_normals(cloud_no_normals, NULL, NULL, NULL, &out, &report));
+  CHECK(out != SENTINEL_MESH && vstree_mesh_has_normals(out) == 1);
+  CHECK(vstree_mesh_has_normals(cloud_no_normals) == 0 && vstree_mesh_vertex_count(out) == n);
+  CHECK(report.struct_size == sizeof report && report.estimated == n && report.oriented == 1);
+  CHECK(report.neighbours == d.neighbours && report.components >= 1 && report.largest_component <= n);
+  {
+    float *normals = (float *)malloc(3 * n * sizeof(float));
+    size_t outward = 0;
+    EXPECT(VSTREE_STATUS_OK, NULL, vstree_mesh_copy_normals(out, normals, 3 * n));
+    for (k = 0; k < n; k++) {
+      const float *truth = tor->normals + 3 * k, *got = normals + 3 * k;
+      outward += truth[0] * got[0] + truth[1] * got[1] + truth[2] * got[2] > 0.0f;
+    }
+    CHECK(outward == n);
+    free(normals);
+  }
+  vstree_mesh_free(out);
+
+  /* A triangle mesh keeps its triangles; NULL report and unoriented are fine. */
+  d.orient = VSTREE_ORIENTATION_UNORIENTED;
+  out = NULL;
+  EXPECT(VSTREE_STATUS_OK, NULL, vstree_estimate_normals(mesh_no_normals, &d, NULL, NULL, &out, NULL));
+  CHECK(vstree_mesh_triangle_count(out) == vstree_mesh_triangle_count(mesh_no_normals));
+  CHECK(vstree_mesh_has_normals(out) == 1);
+  vstree_mesh_free(out);
+
+  cancel_at_every_report("vstree_estimate_normals", normals_call, cloud_no_normals, free_mesh);
+}
+
 int main(int argc, char **argv) {
   torus t = make_torus(48, 24, 0.2f);
-  vstree_mesh *mesh, *cloud, *cloud_no_normals;
+  vstree_mesh *mesh, *cloud, *cloud_no_normals, *mesh_no_normals;
   if (argc != 2) {
     fprintf(stderr, "usage: %s TEMP_DIR\n", argv[0]);
     return 2;
@@ -602,6 +920,7 @@ int main(int argc, char **argv) {
   mesh = torus_mesh(&t, 1, 1);
   cloud = torus_mesh(&t, 1, 0);
   cloud_no_normals = torus_mesh(&t, 0, 0);
+  mesh_no_normals = torus_mesh(&t, 0, 1);
 
   version_and_errors();
   mesh_creation(&t);
@@ -610,10 +929,13 @@ int main(int argc, char **argv) {
   parameter_table(mesh);
   simplification(mesh, cloud, cloud_no_normals);
   trees(mesh);
+  reconstruction(cloud, cloud_no_normals);
+  normal_estimation(&t, cloud_no_normals, mesh_no_normals);
 
   vstree_mesh_free(mesh);
   vstree_mesh_free(cloud);
   vstree_mesh_free(cloud_no_normals);
+  vstree_mesh_free(mesh_no_normals);
   free_torus(&t);
   fprintf(stderr, "test_api: %d bad-input/status rows\n", g_rows);
   return finish("test_api");

@@ -163,6 +163,62 @@ int main(int argc, char **argv) {
     CHECK(l < ts.t_nodes || l == VSTREE_NO_INDEX);
   }
 
+  // Normals and reconstruction from a bare point cloud: 2000 evenly spread points of the unit
+  // sphere (a Fibonacci lattice).
+  {
+    p.clear();
+    for (int i = 0; i < 2000; i++) {
+      float z = 1.0f - (2.0f * float(i) + 1.0f) / 2000.0f, r = std::sqrt(1.0f - z * z);
+      float phi = 2.39996323f * float(i);
+      p.insert(p.end(), {r * std::cos(phi), r * std::sin(phi), z});
+    }
+    vstree::mesh cloud = vstree::mesh::create(p);
+    vstree_normals_report report;
+    std::memset(&report, 0, sizeof report);
+    vstree::mesh with_normals =
+        vstree::estimate_normals(cloud, vstree::default_normal_params(), vstree::progress_fn(), &report);
+    CHECK(with_normals.has_normals() && !cloud.has_normals());
+    CHECK(report.estimated == cloud.vertex_count() && report.oriented == 1);
+    std::vector<float> n = with_normals.normals();
+    std::size_t outward = 0;
+    for (std::size_t i = 0; i < n.size(); i += 3) {
+      outward += n[i] * p[i] + n[i + 1] * p[i + 1] + n[i + 2] * p[i + 2] > 0.0f;
+    }
+    CHECK(outward == cloud.vertex_count());
+
+    vstree_reconstruct_params rp = vstree::default_reconstruct_params();
+    rp.max_levels = 2;
+    rp.max_grid_depth = 6;
+    int calls = 0;
+    vstree::reconstruct_result rr = vstree::reconstruct(cloud, rp, [&](float, const char *) {
+      calls++;
+      return true;
+    });
+    const vstree_reconstruct_stats rs = rr.stats(); // a copy: take_mesh() frees the result
+    CHECK(calls >= 3 && rs.base_genus == 0 && rs.normals_estimated == cloud.vertex_count());
+    CHECK(rs.output_vertices == rr.mesh().vertex_count() && rr.mesh().triangle_count() > 0);
+    CHECK(rs.output_triangles == 2 * rs.output_vertices - 4); // a closed genus-0 mesh
+    vstree::mesh surface = rr.take_mesh();
+    CHECK(surface.has_normals() && surface.vertex_count() == rs.output_vertices);
+
+    expect_error(VSTREE_STATUS_INVALID_PARAMETER, "`max_levels`", [&] {
+      vstree_reconstruct_params bad = vstree::default_reconstruct_params();
+      bad.max_levels = 99;
+      vstree::reconstruct(cloud, bad);
+    });
+    expect_error(VSTREE_STATUS_INVALID_PARAMETER, "`neighbours`", [&] {
+      vstree_normal_params bad = vstree::default_normal_params();
+      bad.neighbours = 1;
+      vstree::estimate_normals(cloud, bad);
+    });
+    expect_error(VSTREE_STATUS_CANCELLED, "cancelled", [&] {
+      vstree::reconstruct(cloud, rp, [](float, const char *) { return false; });
+    });
+    expect_error(VSTREE_STATUS_INVALID_INPUT, "points", [&] {
+      vstree::reconstruct(vstree::mesh::create({0, 0, 0, 1, 0, 0, 0, 1, 0}));
+    });
+  }
+
   std::fprintf(stderr, "test_cpp: %d checks, %d failures\n", g_checks, g_failures);
   return g_failures == 0 ? 0 : 1;
 }

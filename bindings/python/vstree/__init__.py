@@ -8,6 +8,9 @@ through the library's C API with numpy arrays in and out.
     result.stats["clusters"], result.stats["seconds_total"]
     tree = vstree.Tree(mesh)                          # the structure, for viewers
     tree.vertex_labels("cluster")                     # colour the mesh by cluster
+    surface = vstree.reconstruct(points)              # (n, 3) points, or a Mesh cloud
+    surface.mesh.triangles, surface.stats["base_genus"]
+    oriented = vstree.estimate_normals(points)        # a Mesh with normals; .report too
 
 Failures raise :class:`VstreeError` with the C status and the library's message. Depends on
 numpy and the standard library only (Blender's Python has both). The calls release the GIL,
@@ -28,9 +31,13 @@ __all__ = [
     "Mesh",
     "Tree",
     "SimplifyResult",
+    "ReconstructResult",
+    "NormalsResult",
     "VstreeError",
     "CancelledError",
     "simplify",
+    "reconstruct",
+    "estimate_normals",
     "load",
     "version",
     "library_path",
@@ -400,3 +407,128 @@ class Tree:
         out = np.empty(lib.vstree_tree_vertex_count(self._handle), np.uint32)
         _check(lib.vstree_tree_copy_vertex_labels(self._handle, kinds[kind], out.ctypes.data_as(_ffi._U32P), out.size))
         return out
+
+
+# ---- reconstruction and normal estimation ---------------------------------------------------
+
+_ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
+_RECONSTRUCT_FIELDS = (
+    "error",
+    "d_a",
+    "d_d",
+    "max_depth",
+    "max_levels",
+    "min_cell_size",
+    "target_distance",
+    "min_displaced",
+    "max_triangles",
+    "max_grid_depth",
+    "trim",
+    "neighbours",
+    "reorient_given",
+    "threads",
+)
+_NORMAL_FIELDS = ("neighbours", "reorient_given", "threads")
+_UNSIGNED = ("max_depth", "max_levels", "max_triangles", "max_grid_depth", "neighbours", "reorient_given", "threads")
+
+
+def _fill(p, options, fields):
+    """Sets the fields of a C parameter struct from keyword options; ``orient`` by name or
+    number; booleans for ``reorient_given``."""
+    for key, value in options.items():
+        if key == "orient":
+            if isinstance(value, str):
+                if value.lower() not in _ORIENTATIONS:
+                    raise ValueError("orient must be one of %s, not %r" % (sorted(_ORIENTATIONS), value))
+                value = _ORIENTATIONS[value.lower()]
+            if not -(2**31) <= int(value) < 2**31:
+                raise VstreeError(Status.INVALID_PARAMETER, "parameter `orient`: %r is out of range" % (value,))
+            p.orient = int(value)
+        elif key in fields:
+            if key in _UNSIGNED:
+                value = int(value)
+                if not 0 <= value <= 0xFFFFFFFF:
+                    raise VstreeError(
+                        Status.INVALID_PARAMETER, "parameter `%s`: %r is out of range" % (key, value)
+                    )
+            setattr(p, key, value)
+        else:
+            raise TypeError("unknown vstree parameter %r" % key)
+    return p
+
+
+def _cloud(points, normals):
+    """A :class:`Mesh` from a Mesh, or from (n, 3) points and optional normals."""
+    if isinstance(points, Mesh):
+        if normals is not None:
+            raise ValueError("normals are given with the Mesh, not separately")
+        return points
+    return Mesh(points, None, normals)
+
+
+ReconstructResult = namedtuple("ReconstructResult", ["mesh", "stats"])
+ReconstructResult.__doc__ = "The reconstructed :class:`Mesh` (with normals) and a dict of statistics."
+
+NormalsResult = namedtuple("NormalsResult", ["mesh", "report"])
+NormalsResult.__doc__ = "A :class:`Mesh` with normals, and a dict saying what was estimated or flipped."
+
+
+def reconstruct(cloud, normals=None, progress=None, **params):
+    """Reconstructs a closed triangle mesh from a point cloud: ``cloud`` is a :class:`Mesh`
+    (its triangles are ignored) or an (n, 3) array of points, with ``normals`` optional (n, 3);
+    missing normals are estimated and oriented outward. Parameters are the C struct's fields:
+    ``error`` (the tree's L2 bound, the de-noising control; default 1e-5), ``max_levels``
+    (refinement levels, 0-12; default 6), ``target_distance``, ``min_displaced``,
+    ``max_triangles``, ``max_grid_depth`` (4-20; default 10), ``trim`` (grid cells; 0 keeps the
+    closed surface), ``d_a``, ``d_d``, ``max_depth``, ``min_cell_size``, ``orient``
+    ("propagate_outward" | "propagate" | "propagate_majority" | "unoriented"), ``neighbours``,
+    ``reorient_given``, ``threads``.
+
+    ``progress(fraction, stage)`` is called on this thread; returning False cancels
+    (:class:`CancelledError`). Returns ``ReconstructResult(mesh, stats)``; ``stats["base_genus"]``
+    is -1 when the base mesh is not a closed manifold.
+    """
+    mesh = _cloud(cloud, normals)
+    p = lib.vstree_reconstruct_params_default()
+    p.struct_size = ctypes.sizeof(_ffi.ReconstructParams)
+    _fill(p, params, _RECONSTRUCT_FIELDS)
+    cb = _Progress(progress)
+    result = ctypes.c_void_p()
+    cb.check(lib.vstree_reconstruct(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
+    try:
+        stats = lib.vstree_reconstruct_result_get_stats(result).contents
+        if stats.struct_size < ctypes.sizeof(_ffi.ReconstructStats):
+            raise VstreeError(Status.INTERNAL, "the library's statistics are older than this module")
+        stats = _struct_dict(stats)
+    except BaseException:
+        lib.vstree_reconstruct_result_free(result)
+        raise
+    out = ctypes.c_void_p()
+    _check(lib.vstree_reconstruct_result_take_mesh(result, ctypes.byref(out)))
+    return ReconstructResult(Mesh._wrap(out.value), stats)
+
+
+def estimate_normals(cloud, normals=None, progress=None, **params):
+    """Estimates unit normals where ``cloud`` has none (a :class:`Mesh`, whose triangles are
+    kept but not used, or (n, 3) points with optional ``normals``; zero rows count as missing)
+    and orients them; given normals are kept unless ``reorient_given=True``. Parameters:
+    ``orient`` ("propagate_outward", the default, | "propagate" | "propagate_majority" |
+    "unoriented"), ``neighbours`` (3-256; default 16), ``reorient_given``, ``threads``.
+
+    The input is not changed: returns ``NormalsResult(mesh, report)`` with a new :class:`Mesh`
+    (``mesh.normals`` the (n, 3) float32 normals) and a dict (``estimated``, ``flipped``...).
+    """
+    mesh = _cloud(cloud, normals)
+    p = lib.vstree_normal_params_default()
+    p.struct_size = ctypes.sizeof(_ffi.NormalParams)
+    _fill(p, params, _NORMAL_FIELDS)
+    report = _ffi.NormalsReport()
+    report.struct_size = ctypes.sizeof(_ffi.NormalsReport)
+    cb = _Progress(progress)
+    out = ctypes.c_void_p()
+    cb.check(
+        lib.vstree_estimate_normals(
+            mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(out), ctypes.byref(report)
+        )
+    )
+    return NormalsResult(Mesh._wrap(out.value), _struct_dict(report))

@@ -170,6 +170,83 @@ class TreeLevel(Structure):
     ]
 
 
+class NormalParams(Structure):
+    _fields_ = [
+        ("struct_size", c_uint32),
+        ("orient", c_int32),
+        ("neighbours", c_uint32),
+        ("reorient_given", c_uint32),
+        ("threads", c_uint32),
+    ]
+
+
+class NormalsReport(Structure):
+    _fields_ = [
+        ("struct_size", c_uint32),
+        ("oriented", c_uint32),
+        ("estimated", c_uint64),
+        ("neighbours", c_uint64),
+        ("degenerate", c_uint64),
+        ("components", c_uint64),
+        ("largest_component", c_uint64),
+        ("undecided_components", c_uint64),
+        ("flipped", c_uint64),
+    ]
+
+
+class ReconstructParams(Structure):
+    _fields_ = [
+        ("struct_size", c_uint32),
+        ("orient", c_int32),
+        ("error", c_double),
+        ("d_a", c_float),
+        ("d_d", c_float),
+        ("max_depth", c_uint32),
+        ("max_levels", c_uint32),
+        ("min_cell_size", c_double),
+        ("target_distance", c_double),
+        ("min_displaced", c_double),
+        ("max_triangles", c_uint32),
+        ("max_grid_depth", c_uint32),
+        ("trim", c_float),
+        ("neighbours", c_uint32),
+        ("reorient_given", c_uint32),
+        ("threads", c_uint32),
+    ]
+
+
+class ReconstructStats(Structure):
+    _fields_ = [
+        ("struct_size", c_uint32),
+        ("grid_cells", c_uint32),
+        ("base_genus", c_int32),
+        ("levels", c_uint32),
+        ("max_depth", c_uint32),
+        ("normals_neighbours", c_uint32),
+        ("normals_estimated", c_uint64),
+        ("normals_flipped", c_uint64),
+        ("input_points", c_uint64),
+        ("samples", c_uint64),
+        ("nodes", c_uint64),
+        ("t_nodes", c_uint64),
+        ("fine_triangles", c_uint64),
+        ("base_vertices", c_uint64),
+        ("base_triangles", c_uint64),
+        ("base_error", c_double),
+        ("final_error", c_double),
+        ("final_max_error", c_double),
+        ("trimmed_triangles", c_uint64),
+        ("output_vertices", c_uint64),
+        ("output_triangles", c_uint64),
+        ("seconds_normals", c_double),
+        ("seconds_tree", c_double),
+        ("seconds_base", c_double),
+        ("seconds_refine", c_double),
+        ("seconds_trim", c_double),
+        ("seconds_total", c_double),
+    ]
+
+
 # ---- functions ------------------------------------------------------------------------------
 
 _F32P = POINTER(c_float)
@@ -217,6 +294,20 @@ _SIGNATURES = {
     "vstree_tree_copy_t_nodes": (status_t, [c_void_p, POINTER(TNode), c_size_t]),
     "vstree_tree_copy_levels": (status_t, [c_void_p, POINTER(TreeLevel), c_size_t]),
     "vstree_tree_copy_vertex_labels": (status_t, [c_void_p, c_int32, _U32P, c_size_t]),
+    "vstree_normal_params_default": (NormalParams, []),
+    "vstree_estimate_normals": (
+        status_t,
+        [c_void_p, POINTER(NormalParams), PROGRESS, c_void_p, POINTER(c_void_p), POINTER(NormalsReport)],
+    ),
+    "vstree_reconstruct_params_default": (ReconstructParams, []),
+    "vstree_reconstruct": (
+        status_t,
+        [c_void_p, POINTER(ReconstructParams), PROGRESS, c_void_p, POINTER(c_void_p)],
+    ),
+    "vstree_reconstruct_result_get_mesh": (c_void_p, [c_void_p]),
+    "vstree_reconstruct_result_get_stats": (POINTER(ReconstructStats), [c_void_p]),
+    "vstree_reconstruct_result_free": (None, [c_void_p]),
+    "vstree_reconstruct_result_take_mesh": (status_t, [c_void_p, POINTER(c_void_p)]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():
@@ -239,5 +330,7 @@ if _abi != ABI_VERSION:
     )
 if lib.vstree_simplify_params_default().struct_size < ctypes.sizeof(SimplifyParams):
     raise ImportError("vstree: %s is older than this module (parameter struct)" % library_path)
+if lib.vstree_reconstruct_params_default().struct_size < ctypes.sizeof(ReconstructParams):
+    raise ImportError("vstree: %s is older than this module (reconstruction parameters)" % library_path)
 
 version = lib.vstree_version().decode()

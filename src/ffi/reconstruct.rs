@@ -1,0 +1,397 @@
+//! Surface reconstruction from a point cloud: the parameter struct, the call, and its result
+//! handle with the output mesh and statistics.
+
+use super::mesh::{into_handle, mesh_ref, vstree_mesh};
+use super::normals::{flag, orientation, orientation_value, threads};
+use super::params::{self, Versioned};
+use super::progress::{vstree_progress_fn, with_progress};
+use super::{guard, guard_or, non_null, vstree_status, write_out, FfiResult};
+use crate::normals::NormalParams;
+use crate::reconstruct::{reconstruct, ReconstructParams, ReconstructStats};
+use crate::tree::{Metric, TreeKind, TreeParams};
+use std::ffi::c_void;
+use std::mem::size_of;
+use std::time::Instant;
+
+/// Parameters of vstree_reconstruct(). Always start from vstree_reconstruct_params_default()
+/// and change fields by name: it sets `struct_size`, and fields added in later versions then
+/// keep their defaults. Passing NULL means the defaults. The struct has no padding; every field
+/// is checked, and an out-of-range one fails the call with VSTREE_STATUS_INVALID_PARAMETER and
+/// a message naming it.
+///
+/// The tree is always a Volume-Surface Tree with the quadric (L2) metric; its fields are those
+/// of ::vstree_simplify_params with other defaults. The normal-estimation fields are those of
+/// ::vstree_normal_params; `threads` applies to the whole call.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct vstree_reconstruct_params {
+    /// Size of this struct in bytes as the caller knows it; set by the _default() function.
+    pub struct_size: u32,
+    /// How estimated normals get their signs (VSTREE_ORIENTATION_* value); used only where the
+    /// cloud has no normals, or for all of them with `reorient_given`. Default
+    /// VSTREE_ORIENTATION_PROPAGATE_OUTWARD (reconstruction needs outward normals).
+    pub orient: i32,
+    /// The tree's L2 bound: squared distance from a cluster's point to its samples' tangent
+    /// planes, over the squared bounding-box diagonal. The de-noising control (larger =
+    /// smoother, fewer details). Finite and > 0; default 1e-5.
+    pub error: f64,
+    /// Height-field test, normal cone (see ::vstree_simplify_params). Unitless, in [0, 1];
+    /// default 0. Raising it makes the base mesh denser where curvature is high.
+    pub d_a: f32,
+    /// Height-field test, displacement (see ::vstree_simplify_params). Unitless, in [0, 1];
+    /// default 1/6.
+    pub d_d: f32,
+    /// Deepest tree level, in [1, 30]; default 24.
+    pub max_depth: u32,
+    /// Most refinement levels, each multiplying the triangle count by 4; in [0, 12], default 6.
+    pub max_levels: u32,
+    /// Cells smaller than this fraction of the bounding-box diagonal are not split. In [0, 1);
+    /// default 1e-7.
+    pub min_cell_size: f64,
+    /// Refinement stops once the RMS distance from the samples to the mesh, over the
+    /// bounding-box diagonal, is at most this. Finite, >= 0; default 0 (refine until the
+    /// quadtrees have no detail left or `max_levels`).
+    pub target_distance: f64,
+    /// A level that displaces fewer than this fraction of its new vertices ends refinement.
+    /// Unitless, in [0, 1]; default 0.02.
+    pub min_displaced: f64,
+    /// No refinement level is started that would exceed this many triangles. In [1, 2^32 - 1];
+    /// default 20,000,000.
+    pub max_triangles: u32,
+    /// The polygonisation grid is never finer than 2^`max_grid_depth` cells across the cloud's
+    /// bounding cube. In [4, 20]; default 10.
+    pub max_grid_depth: u32,
+    /// Faces farther than this many grid cells from every sample are removed (open scans give
+    /// open meshes). Finite, >= 0; default 0 (keep the closed surface).
+    pub trim: f32,
+    /// Neighbours per point for normal estimation, in [3, 256]; default 16.
+    pub neighbours: u32,
+    /// 0 (default): normals the cloud has are kept. 1: they are re-oriented with `orient`.
+    pub reorient_given: u32,
+    /// Worker threads: 0 = all cores (default), else at most 1024. Results do not depend on it.
+    pub threads: u32,
+}
+
+unsafe impl Versioned for vstree_reconstruct_params {
+    const NAME: &'static str = "vstree_reconstruct_params";
+    const MIN_SIZE: usize = 80;
+    fn defaults() -> Self {
+        let d = ReconstructParams::default();
+        vstree_reconstruct_params {
+            struct_size: size_of::<Self>() as u32,
+            orient: orientation_value(d.normals.orient),
+            error: d.tree.error,
+            d_a: d.tree.d_a,
+            d_d: d.tree.d_d,
+            max_depth: d.tree.max_depth,
+            max_levels: d.max_levels,
+            min_cell_size: d.tree.min_cell_size,
+            target_distance: d.target_distance,
+            min_displaced: d.min_displaced,
+            max_triangles: u32::try_from(d.max_triangles).unwrap_or(u32::MAX),
+            max_grid_depth: d.max_grid_depth,
+            trim: d.trim,
+            neighbours: d.normals.neighbours as u32,
+            reorient_given: u32::from(d.normals.reorient_given),
+            threads: 0,
+        }
+    }
+}
+
+/// The default parameters, with `struct_size` set. Thread-safe; returns a value (nothing to
+/// free).
+#[no_mangle]
+pub extern "C" fn vstree_reconstruct_params_default() -> vstree_reconstruct_params {
+    vstree_reconstruct_params::defaults()
+}
+
+/// Reads and checks the caller's parameters (NULL: defaults), naming any bad field.
+pub(crate) unsafe fn read_reconstruct_params(
+    pointer: *const vstree_reconstruct_params,
+) -> FfiResult<ReconstructParams> {
+    let p = unsafe { params::read(pointer, "params") }?;
+    let threads = threads(p.threads)?;
+    let normals = NormalParams {
+        neighbours: p.neighbours as usize,
+        orient: orientation(p.orient)?,
+        reorient_given: flag("reorient_given", p.reorient_given)?,
+        threads,
+    };
+    normals.check()?;
+    let params = ReconstructParams {
+        tree: TreeParams {
+            kind: TreeKind::VsTree,
+            metric: Metric::L2,
+            error: p.error,
+            d_a: p.d_a,
+            d_d: p.d_d,
+            max_depth: p.max_depth,
+            min_cell_size: p.min_cell_size,
+        },
+        target_distance: p.target_distance,
+        max_levels: p.max_levels,
+        min_displaced: p.min_displaced,
+        max_triangles: p.max_triangles as usize,
+        max_grid_depth: p.max_grid_depth,
+        trim: p.trim,
+        normals,
+        threads,
+    };
+    params.check()?;
+    Ok(params)
+}
+
+/// What a reconstruction did. Owned by its result (vstree_reconstruct_result_get_stats());
+/// later versions only add fields at the end, and `struct_size` says how many there are.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct vstree_reconstruct_stats {
+    /// Size of this struct in bytes as the library filled it.
+    pub struct_size: u32,
+    /// Cells across the polygonisation grid of the base mesh (a power of two).
+    pub grid_cells: u32,
+    /// Genus of the base mesh M0, or -1 when M0 is not a closed manifold.
+    pub base_genus: i32,
+    /// Refinement levels done (each splits every triangle in 4).
+    pub levels: u32,
+    /// Deepest level of the tree (the root is level 0).
+    pub max_depth: u32,
+    /// Neighbours per point used for normal estimation (0 when the cloud's normals were kept).
+    pub normals_neighbours: u32,
+    /// Normals estimated (0 when the cloud's own were all kept).
+    pub normals_estimated: u64,
+    /// Normals whose sign the orientation changed.
+    pub normals_flipped: u64,
+    /// Points of the input cloud.
+    pub input_points: u64,
+    /// Samples the tree was built from.
+    pub samples: u64,
+    /// Nodes of the tree, of every kind.
+    pub nodes: u64,
+    /// Transition nodes: one vertex of the base mesh M0 each, at most.
+    pub t_nodes: u64,
+    /// Triangles of the fine polygonisation clustered into M0.
+    pub fine_triangles: u64,
+    /// Vertices of the base mesh M0.
+    pub base_vertices: u64,
+    /// Triangles of the base mesh M0.
+    pub base_triangles: u64,
+    /// RMS distance from the samples to M0, over the bounding-box diagonal.
+    pub base_error: f64,
+    /// RMS distance from the samples to the final mesh (before trimming), over the diagonal.
+    pub final_error: f64,
+    /// Largest distance from a sample to the final mesh (before trimming), over the diagonal.
+    pub final_max_error: f64,
+    /// Triangles removed by trimming (0 when `trim` is 0).
+    pub trimmed_triangles: u64,
+    /// Vertices of the output mesh.
+    pub output_vertices: u64,
+    /// Triangles of the output mesh.
+    pub output_triangles: u64,
+    /// Seconds estimating normals (and taking the samples).
+    pub seconds_normals: f64,
+    /// Seconds building the tree.
+    pub seconds_tree: f64,
+    /// Seconds making the base mesh M0.
+    pub seconds_base: f64,
+    /// Seconds refining.
+    pub seconds_refine: f64,
+    /// Seconds trimming.
+    pub seconds_trim: f64,
+    /// Seconds in the whole library call, from parameter check to result.
+    pub seconds_total: f64,
+}
+
+/// The C statistics of a reconstruction of `input_points` points.
+pub(crate) fn stats_of(s: &ReconstructStats, input_points: usize, seconds_total: f64) -> vstree_reconstruct_stats {
+    vstree_reconstruct_stats {
+        struct_size: size_of::<vstree_reconstruct_stats>() as u32,
+        grid_cells: s.grid_cells,
+        base_genus: s.base_genus.and_then(|g| i32::try_from(g).ok()).unwrap_or(-1),
+        levels: s.levels.len() as u32,
+        max_depth: s.tree.max_depth,
+        normals_neighbours: s.normals.neighbours as u32,
+        normals_estimated: s.normals.estimated as u64,
+        normals_flipped: s.normals.orient.map_or(0, |o| o.flipped as u64),
+        input_points: input_points as u64,
+        samples: s.tree.samples as u64,
+        nodes: s.tree.nodes as u64,
+        t_nodes: s.tree.t_nodes as u64,
+        fine_triangles: s.fine_triangles as u64,
+        base_vertices: s.base_vertices as u64,
+        base_triangles: s.base_triangles as u64,
+        base_error: s.base_error,
+        final_error: s.final_error,
+        final_max_error: s.final_max_error,
+        trimmed_triangles: s.trimmed_triangles as u64,
+        output_vertices: s.output_vertices as u64,
+        output_triangles: s.output_triangles as u64,
+        seconds_normals: s.seconds_normals,
+        seconds_tree: s.seconds_tree,
+        seconds_base: s.seconds_base,
+        seconds_refine: s.seconds_refine,
+        seconds_trim: s.seconds_trim,
+        seconds_total,
+    }
+}
+
+/// The output of vstree_reconstruct(): the reconstructed mesh and what was done. Opaque; freed
+/// with vstree_reconstruct_result_free(), which frees the mesh it holds too. Immutable: several
+/// threads may read it at once.
+pub struct vstree_reconstruct_result {
+    mesh: vstree_mesh,
+    stats: vstree_reconstruct_stats,
+}
+
+/// Reconstructs a triangle mesh from the points of `cloud` (its triangles, if any, are
+/// ignored): normals are estimated where the cloud has none (all, or zero-length ones), the
+/// VS-Tree of the points is built, its T-nodes give a coarse closed base mesh, which is
+/// refined by the quadtrees below them until it is close enough to the points; with
+/// `params->trim` > 0, faces far from every point are removed at the end. The output has
+/// unit per-vertex normals and counter-clockwise triangles seen from outside.
+///
+/// `params` NULL means the defaults. `progress` (may be NULL) is called with `user_data` from
+/// the calling thread as the work goes; returning 0 from it cancels. On success the new result
+/// is written to `*out_result` and belongs to the caller, who frees it with
+/// vstree_reconstruct_result_free(); the caller keeps ownership of `cloud`, which is not
+/// changed. On failure nothing is written and nothing is left allocated.
+///
+/// Fails with VSTREE_STATUS_NULL_POINTER, VSTREE_STATUS_INVALID_ARGUMENT (bad
+/// `params->struct_size`), VSTREE_STATUS_INVALID_PARAMETER, VSTREE_STATUS_INVALID_INPUT (fewer
+/// than 10 points, points all on a line, normals so inconsistent that no surface is found),
+/// VSTREE_STATUS_TOO_LARGE (the surface needs more grid cells than the library allows) or
+/// VSTREE_STATUS_CANCELLED. Thread-safe: calls on different clouds, or on the same cloud, may
+/// run at once from different threads.
+#[no_mangle]
+pub unsafe extern "C" fn vstree_reconstruct(
+    cloud: *const vstree_mesh,
+    params: *const vstree_reconstruct_params,
+    progress: vstree_progress_fn,
+    user_data: *mut c_void,
+    out_result: *mut *mut vstree_reconstruct_result,
+) -> vstree_status {
+    guard("vstree_reconstruct", || {
+        let start = Instant::now();
+        non_null(out_result, "out_result")?;
+        let cloud = unsafe { mesh_ref(cloud, "cloud") }?;
+        let params = unsafe { read_reconstruct_params(params) }?;
+        let (out, s) = with_progress(progress, user_data, |p| reconstruct(cloud, &params, p))?;
+        let stats = stats_of(&s, cloud.positions.len(), start.elapsed().as_secs_f64());
+        let result = Box::new(vstree_reconstruct_result { mesh: vstree_mesh { mesh: out }, stats });
+        unsafe { write_out(out_result, Box::into_raw(result)) };
+        Ok(())
+    })
+}
+
+/// The reconstructed mesh, owned by `result`: valid until vstree_reconstruct_result_free(result),
+/// and never to be passed to vstree_mesh_free(). Use it with every `const vstree_mesh *`
+/// function (counts, copies, vstree_mesh_save(), vstree_simplify()). NULL for NULL.
+#[no_mangle]
+pub unsafe extern "C" fn vstree_reconstruct_result_get_mesh(
+    result: *const vstree_reconstruct_result,
+) -> *const vstree_mesh {
+    guard_or(std::ptr::null(), || match result.is_null() {
+        true => std::ptr::null(),
+        // SAFETY: a live result from vstree_reconstruct(), by the caller's contract.
+        false => unsafe { &(*result).mesh as *const vstree_mesh },
+    })
+}
+
+/// The statistics of the reconstruction, owned by `result` (valid until it is freed; do not
+/// free it). NULL for NULL.
+#[no_mangle]
+pub unsafe extern "C" fn vstree_reconstruct_result_get_stats(
+    result: *const vstree_reconstruct_result,
+) -> *const vstree_reconstruct_stats {
+    guard_or(std::ptr::null(), || match result.is_null() {
+        true => std::ptr::null(),
+        // SAFETY: as above.
+        false => unsafe { &(*result).stats as *const vstree_reconstruct_stats },
+    })
+}
+
+/// Frees a result of vstree_reconstruct() and the mesh and statistics it owns. NULL is a
+/// no-op.
+#[no_mangle]
+pub unsafe extern "C" fn vstree_reconstruct_result_free(result: *mut vstree_reconstruct_result) {
+    guard_or((), || {
+        if !result.is_null() {
+            // SAFETY: a result this library boxed; the caller gives up ownership.
+            drop(unsafe { Box::from_raw(result) });
+        }
+    })
+}
+
+/// Moves the mesh out of a reconstruction result into its own handle: `*out_mesh` gets a new
+/// mesh the caller frees with vstree_mesh_free(), and `result` is freed (it must not be used
+/// again, whatever the status). Fails with VSTREE_STATUS_NULL_POINTER; when `out_mesh` is NULL
+/// the result is left alone.
+#[no_mangle]
+pub unsafe extern "C" fn vstree_reconstruct_result_take_mesh(
+    result: *mut vstree_reconstruct_result,
+    out_mesh: *mut *mut vstree_mesh,
+) -> vstree_status {
+    guard("vstree_reconstruct_result_take_mesh", || {
+        non_null(out_mesh, "out_mesh")?;
+        let result = non_null(result, "result")?;
+        // SAFETY: a result this library boxed; the caller gives up ownership.
+        let result = unsafe { Box::from_raw(result.cast_mut()) };
+        unsafe { write_out(out_mesh, into_handle(result.mesh.mesh)) };
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::mem::offset_of;
+
+    #[test]
+    fn layouts_have_no_padding() {
+        assert_eq!(size_of::<vstree_reconstruct_params>(), 80);
+        assert_eq!(offset_of!(vstree_reconstruct_params, error), 8);
+        assert_eq!(offset_of!(vstree_reconstruct_params, min_cell_size), 32);
+        assert_eq!(offset_of!(vstree_reconstruct_params, max_triangles), 56);
+        assert_eq!(offset_of!(vstree_reconstruct_params, threads), 76);
+        assert_eq!(size_of::<vstree_reconstruct_stats>(), 24 + 21 * 8);
+    }
+
+    #[test]
+    fn defaults_are_the_rust_defaults() {
+        let p = unsafe { read_reconstruct_params(std::ptr::null()) }.unwrap();
+        assert_eq!(p, ReconstructParams::default());
+        let q = unsafe { read_reconstruct_params(&vstree_reconstruct_params_default()) }.unwrap();
+        assert_eq!(q, ReconstructParams::default());
+    }
+
+    #[test]
+    fn every_field_is_checked_by_name() {
+        type Spoil = fn(&mut vstree_reconstruct_params);
+        let cases: [(&str, Spoil); 17] = [
+            ("orient", |p| p.orient = 4),
+            ("error", |p| p.error = 0.0),
+            ("error", |p| p.error = f64::NAN),
+            ("d_a", |p| p.d_a = 1.5),
+            ("d_d", |p| p.d_d = f32::NAN),
+            ("max_depth", |p| p.max_depth = 0),
+            ("max_levels", |p| p.max_levels = 13),
+            ("min_cell_size", |p| p.min_cell_size = 1.0),
+            ("target_distance", |p| p.target_distance = -1.0),
+            ("target_distance", |p| p.target_distance = f64::INFINITY),
+            ("min_displaced", |p| p.min_displaced = f64::NAN),
+            ("max_triangles", |p| p.max_triangles = 0),
+            ("max_grid_depth", |p| p.max_grid_depth = 21),
+            ("trim", |p| p.trim = -1.0),
+            ("neighbours", |p| p.neighbours = 1000),
+            ("reorient_given", |p| p.reorient_given = 7),
+            ("threads", |p| p.threads = u32::MAX),
+        ];
+        for (field, spoil) in cases {
+            let mut p = vstree_reconstruct_params_default();
+            spoil(&mut p);
+            let e = unsafe { read_reconstruct_params(&p) }.unwrap_err();
+            assert_eq!(e.status, vstree_status::InvalidParameter, "{field}");
+            assert!(e.message.contains(&format!("`{field}`")), "{}", e.message);
+        }
+    }
+}
