@@ -307,14 +307,12 @@ fn evenly_spread(points: &[Vec3], n: usize) -> Vec<Vec3> {
 /// error(M, S): RMS and max distance from `points` to the surface, over `diagonal`.
 fn sample_error(s: &refine::Surface, points: &[Vec3], diagonal: f32, threads: &Threads) -> (f64, f64) {
     let mesh = Mesh { positions: s.positions.clone(), normals: None, triangles: s.triangles.clone() };
-    let (sum_sq, max) = threads.run(|| {
+    let distances: Vec<f64> = threads.run(|| {
         let bvh = TriangleBvh::new(&mesh);
-        points
-            .par_iter()
-            .map(|&p| f64::from(bvh.distance(p)))
-            .fold(|| (0.0, 0.0f64), |(s, m), d| (s + d * d, m.max(d)))
-            .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)))
+        points.par_iter().map(|&p| f64::from(bvh.distance(p))).collect()
     });
+    // Summed in order, so the figure is the same whatever the thread count.
+    let (sum_sq, max) = distances.iter().fold((0.0, 0.0f64), |(s, m), &d| (s + d * d, m.max(d)));
     let d = f64::from(diagonal).max(f64::MIN_POSITIVE);
     ((sum_sq / points.len().max(1) as f64).sqrt() / d, max / d)
 }
