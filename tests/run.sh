@@ -18,17 +18,17 @@ cargo clippy --locked --lib --no-default-features -- -D warnings
 echo "== Rust tests"
 cargo test --locked
 
-echo "== C API header: include/vstree.h must be what cbindgen makes of src/ffi"
+echo "== C API header: include/vstree.h must be what cbindgen makes of the crate"
 CBINDGEN_VERSION=0.29.2
 if ! cbindgen --version 2>/dev/null | grep -qx "cbindgen $CBINDGEN_VERSION"; then
     cargo install cbindgen --locked --version "$CBINDGEN_VERSION"
 fi
 generated=$(mktemp)
 trap 'rm -f "$generated"' EXIT
-cbindgen --quiet --config cbindgen.toml --output "$generated" src/ffi/mod.rs
+cbindgen --quiet --config cbindgen.toml --output "$generated" .
 if ! diff -u include/vstree.h "$generated"; then
     echo "include/vstree.h is out of date; regenerate it with" >&2
-    echo "  cbindgen --config cbindgen.toml --output include/vstree.h src/ffi/mod.rs" >&2
+    echo "  cbindgen --config cbindgen.toml --output include/vstree.h ." >&2
     exit 1
 fi
 
