@@ -2,6 +2,8 @@
 //! a message when absent) and the samples of a mesh or cloud.
 #![allow(dead_code)]
 
+pub mod ffi;
+
 use std::path::PathBuf;
 use vstree::{Mesh, MeshSampling, SampleSet};
 
