@@ -1,0 +1,426 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// vstree MeshLab filter plugin: VS-Tree clustering simplification, surface reconstruction
+// and cluster colouring through the vstree C API. Copyright the vstree authors.
+// This program is free software: you can redistribute it and/or modify it under the terms
+// of the GNU General Public License as published by the Free Software Foundation, either
+// version 3 of the License, or (at your option) any later version.
+#include "filter_vstree.h"
+
+#include <vcg/complex/algorithms/update/bounding.h>
+#include <vcg/complex/algorithms/update/normal.h>
+
+#include <vstree.h>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace {
+
+const QStringList kTreeKinds{"VS-Tree", "Octree"};
+const QStringList kMetrics{"L2 (quadric)", "L2,1 (normal deviation)", "Density (samples)"};
+const QStringList kSamplings{"Vertices", "Face centers"};
+const QStringList kLabelKinds{"Cluster", "T-node"};
+
+// A vstree status other than OK becomes an MLException carrying the C API's own message;
+// pymeshlab turns it into pymeshlab.PyMeshLabException.
+void check(vstree_status st, const char* what)
+{
+	if (st == VSTREE_STATUS_OK)
+		return;
+	const QString detail = QString::fromUtf8(vstree_last_error_message());
+	throw MLException(QString("vstree %1 failed (%2): %3")
+						  .arg(what)
+						  .arg(QString::fromUtf8(vstree_status_str(st)))
+						  .arg(detail));
+}
+
+struct Progress
+{
+	vcg::CallBackPos* cb;
+	int               lastPercent = -1;
+};
+
+int32_t progressTrampoline(void* user, float fraction, const char* stage)
+{
+	auto* p = static_cast<Progress*>(user);
+	if (p->cb == nullptr)
+		return 1;
+	int percent = int(std::lround(double(fraction) * 100.0));
+	if (percent != p->lastPercent) {
+		p->lastPercent = percent;
+		p->cb(percent, stage != nullptr ? stage : "");
+	}
+	return 1; // never cancel: MeshLab's callback result is not a cancel request
+}
+
+// Live (non-deleted) vertices and faces of a CMeshO as flat arrays.
+struct Arrays
+{
+	std::vector<float>    pos;
+	std::vector<float>    nrm;
+	std::vector<uint32_t> tri;
+	std::vector<int>      vertIndex; // compact index -> index in m.vert
+	size_t                zeroNormals = 0;
+};
+
+Arrays toArrays(const CMeshO& m)
+{
+	Arrays a;
+	std::vector<uint32_t> remap(m.vert.size(), UINT32_MAX);
+	for (size_t i = 0; i < m.vert.size(); ++i) {
+		const auto& v = m.vert[i];
+		if (v.IsD())
+			continue;
+		remap[i] = uint32_t(a.vertIndex.size());
+		a.vertIndex.push_back(int(i));
+		for (int k = 0; k < 3; ++k) {
+			a.pos.push_back(float(v.cP()[k]));
+			a.nrm.push_back(float(v.cN()[k]));
+		}
+		if (v.cN().SquaredNorm() == 0 || !std::isfinite(double(v.cN().SquaredNorm())))
+			++a.zeroNormals;
+	}
+	for (const auto& f : m.face) {
+		if (f.IsD())
+			continue;
+		for (int k = 0; k < 3; ++k)
+			a.tri.push_back(remap[vcg::tri::Index(m, f.cV(k))]);
+	}
+	return a;
+}
+
+struct MeshHandle
+{
+	vstree_mesh* p = nullptr;
+	~MeshHandle() { vstree_mesh_free(p); }
+};
+
+// Copy a vstree mesh into an (empty) CMeshO.
+void fromVstree(const vstree_mesh* vm, CMeshO& out)
+{
+	const size_t nv = vstree_mesh_vertex_count(vm);
+	const size_t nt = vstree_mesh_triangle_count(vm);
+	std::vector<float>    pos(nv * 3), nrm;
+	std::vector<uint32_t> tri(nt * 3);
+	check(vstree_mesh_copy_positions(vm, pos.data(), pos.size()), "copy positions");
+	check(vstree_mesh_copy_triangles(vm, nt ? tri.data() : nullptr, tri.size()), "copy triangles");
+	const bool hasN = vstree_mesh_has_normals(vm) == 1;
+	if (hasN) {
+		nrm.resize(nv * 3);
+		check(vstree_mesh_copy_normals(vm, nrm.data(), nrm.size()), "copy normals");
+	}
+	out.Clear();
+	auto vi = vcg::tri::Allocator<CMeshO>::AddVertices(out, nv);
+	for (size_t i = 0; i < nv; ++i, ++vi) {
+		vi->P() = Point3m(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]);
+		if (hasN)
+			vi->N() = Point3m(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
+	}
+	if (nt > 0) {
+		auto fi = vcg::tri::Allocator<CMeshO>::AddFaces(out, nt);
+		for (size_t t = 0; t < nt; ++t, ++fi)
+			for (int k = 0; k < 3; ++k)
+				fi->V(k) = &out.vert[tri[3 * t + k]];
+		vcg::tri::UpdateNormal<CMeshO>::PerFaceNormalized(out);
+		if (!hasN)
+			vcg::tri::UpdateNormal<CMeshO>::PerVertexNormalizedPerFace(out);
+	}
+	vcg::tri::UpdateBounding<CMeshO>::Box(out);
+}
+
+// The vstree input mesh of a MeshLab layer. Triangle meshes go without normals (vstree takes
+// area-weighted ones from the triangles); point clouds go with their normals when every point
+// has one, else without (simplification then reports the missing normals).
+void makeInput(const CMeshO& m, const Arrays& a, bool withNormals, MeshHandle& h)
+{
+	if (a.vertIndex.empty())
+		throw MLException("vstree: the current layer has no vertices");
+	const float* n = withNormals ? a.nrm.data() : nullptr;
+	check(vstree_mesh_create(a.pos.data(), a.vertIndex.size(), n, a.tri.empty() ? nullptr : a.tri.data(),
+			  a.tri.size() / 3, &h.p),
+		"mesh_create");
+	(void)m;
+}
+
+vstree_simplify_params simplifyParams(const RichParameterList& par)
+{
+	vstree_simplify_params p = vstree_simplify_params_default();
+	p.tree_kind = par.getEnum("tree_kind") == 1 ? VSTREE_TREE_KIND_OCTREE : VSTREE_TREE_KIND_VS_TREE;
+	switch (par.getEnum("metric")) {
+	case 1: p.metric = VSTREE_METRIC_L21; break;
+	case 2: p.metric = VSTREE_METRIC_DENSITY; break;
+	default: p.metric = VSTREE_METRIC_L2; break;
+	}
+	p.sampling = par.getEnum("sampling") == 1 ? VSTREE_SAMPLING_FACE_CENTERS : VSTREE_SAMPLING_VERTICES;
+	p.error    = double(par.getFloat("error"));
+	p.d_a      = float(par.getFloat("d_a"));
+	p.d_d      = float(par.getFloat("d_d"));
+	p.max_depth = uint32_t(std::max(0, par.getInt("max_depth")));
+	return p;
+}
+
+void addTreeParams(RichParameterList& pl, double defError)
+{
+	pl.addParam(RichFloat("error", Scalarm(defError), "Error bound",
+		"Split threshold per cluster, read according to the metric. L2 (quadric): a relative "
+		"bound, the squared distance from a cluster's point to its samples' tangent planes over "
+		"the squared bounding-box diagonal (1e-3 = planes within about 3% of the diagonal; larger "
+		"= coarser). L2,1: unitless normal deviation, 1e-3 to 4. Density: a sample count >= 1."));
+	pl.addParam(RichEnum("tree_kind", 0, kTreeKinds, "Tree",
+		"VS-Tree (octree far from the surface, quadtrees in local frames near it) or a plain Octree."));
+	pl.addParam(RichEnum("metric", 0, kMetrics, "Metric", "The error metric that decides whether a cell is split."));
+	pl.addParam(RichFloat("d_a", 0, "d_a (normal cone)",
+		"Height-field test: a cell becomes a surface node only if every sample normal has a dot "
+		"product above d_a with the mean normal. Unitless, in [0, 1]."));
+	pl.addParam(RichFloat("d_d", Scalarm(1.0 / 6.0), "d_d (displacement)",
+		"Height-field test: sample heights above the cell's mean plane over its radius must stay "
+		"below d_d. Unitless, in [0, 1]."));
+	pl.addParam(RichEnum("sampling", 0, kSamplings, "Sampling",
+		"Which elements become the tree's samples: vertices (area-weighted normals) or face centers. "
+		"Point clouds always use their points."));
+	pl.addParam(RichInt("max_depth", 24, "Max depth", "Deepest tree level, in [1, 30]."));
+}
+
+uint32_t hashColour(uint32_t x)
+{
+	x ^= x >> 16; x *= 0x7feb352dU; x ^= x >> 15; x *= 0x846ca68bU; x ^= x >> 16;
+	return x;
+}
+
+} // namespace
+
+FilterVstreePlugin::FilterVstreePlugin()
+{
+	typeList = {FP_SIMPLIFY, FP_RECONSTRUCT, FP_COLOUR};
+	for (ActionIDType tt : types())
+		actionList.push_back(new QAction(filterName(tt), this));
+}
+
+QString FilterVstreePlugin::pluginName() const { return "FilterVstree"; }
+QString FilterVstreePlugin::vendor() const { return "vstree"; }
+
+QString FilterVstreePlugin::filterName(ActionIDType f) const
+{
+	switch (f) {
+	case FP_SIMPLIFY: return "VS-Tree Clustering Simplification";
+	case FP_RECONSTRUCT: return "VS-Tree Surface Reconstruction";
+	case FP_COLOUR: return "VS-Tree Cluster Colouring";
+	default: return QString();
+	}
+}
+
+QString FilterVstreePlugin::pythonFilterName(ActionIDType f) const
+{
+	switch (f) {
+	case FP_SIMPLIFY: return "vstree_clustering_simplification";
+	case FP_RECONSTRUCT: return "vstree_surface_reconstruction";
+	case FP_COLOUR: return "vstree_cluster_colouring";
+	default: return FilterPlugin::pythonFilterName(f);
+	}
+}
+
+QString FilterVstreePlugin::filterInfo(ActionIDType f) const
+{
+	const QString ver = QString(" (libvstree %1)").arg(QString::fromUtf8(vstree_version()));
+	switch (f) {
+	case FP_SIMPLIFY:
+		return "Clustering simplification with a Volume-Surface Tree (Boubekeur et al. 2006): every "
+			   "cluster of the tree becomes one vertex. The result is a <b>new layer</b>; the source "
+			   "layer is not changed. Works on triangle meshes and on point clouds with normals." + ver;
+	case FP_RECONSTRUCT:
+		return "Surface reconstruction from a point set with a VS-Tree: a coarse closed base mesh from "
+			   "the T-nodes, refined by the quadtrees. Normals are estimated where missing (unless "
+			   "disabled). The result is a <b>new layer</b>." + ver;
+	case FP_COLOUR:
+		return "Colours the vertices of the current layer by the VS-Tree cluster (or T-node) they "
+			   "belong to, one hash colour per label; unlabelled vertices become grey." + ver;
+	default: return QString();
+	}
+}
+
+FilterPlugin::FilterClass FilterVstreePlugin::getClass(const QAction* a) const
+{
+	switch (ID(a)) {
+	case FP_SIMPLIFY: return FilterPlugin::Remeshing;
+	case FP_RECONSTRUCT: return FilterClass(FilterPlugin::PointSet | FilterPlugin::Remeshing);
+	case FP_COLOUR: return FilterPlugin::VertexColoring;
+	default: return FilterPlugin::Other;
+	}
+}
+
+FilterPlugin::FilterArity FilterVstreePlugin::filterArity(const QAction*) const { return SINGLE_MESH; }
+
+int FilterVstreePlugin::getPreConditions(const QAction*) const
+{
+	// Point clouds are valid input for all three; vstree itself reports what is missing.
+	return MeshModel::MM_NONE;
+}
+
+int FilterVstreePlugin::postCondition(const QAction* a) const
+{
+	switch (ID(a)) {
+	case FP_COLOUR: return MeshModel::MM_VERTCOLOR;
+	default: return MeshModel::MM_NONE; // new layer, source untouched
+	}
+}
+
+RichParameterList FilterVstreePlugin::initParameterList(const QAction* a, const MeshModel&)
+{
+	RichParameterList pl;
+	switch (ID(a)) {
+	case FP_SIMPLIFY:
+		addTreeParams(pl, 1e-3);
+		break;
+	case FP_COLOUR:
+		addTreeParams(pl, 1e-3);
+		pl.addParam(RichEnum("label", 0, kLabelKinds, "Colour by",
+			"Cluster: one colour per cluster (leaf). T-node: one colour per T-node of the T-layer."));
+		break;
+	case FP_RECONSTRUCT:
+		pl.addParam(RichFloat("error", Scalarm(1e-5), "Error bound",
+			"The tree's relative L2 bound: squared distance from a cluster's point to its samples' "
+			"tangent planes over the squared bounding-box diagonal. The de-noising control: larger = "
+			"smoother, fewer details."));
+		pl.addParam(RichInt("levels", 6, "Refinement levels",
+			"Most refinement levels, each multiplying the triangle count by 4; in [0, 12]."));
+		pl.addParam(RichFloat("trim", 0, "Trim",
+			"Faces farther than this many grid cells from every point are removed (open scans give "
+			"open meshes). 0 keeps the closed surface."));
+		pl.addParam(RichBool("estimate_normals", true, "Estimate normals",
+			"Estimate (and orient outward) the normals the point set lacks. When off, the point set "
+			"must have normals."));
+		break;
+	default: break;
+	}
+	return pl;
+}
+
+std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
+	const QAction*           action,
+	const RichParameterList& par,
+	MeshDocument&            md,
+	unsigned int&            /*postConditionMask*/,
+	vcg::CallBackPos*        cb)
+{
+	std::map<std::string, QVariant> out;
+	MeshModel* src = md.mm();
+	if (src == nullptr)
+		throw MLException("vstree: no current mesh");
+	Progress prog{cb};
+	const Arrays a = toArrays(src->cm);
+	const bool   isCloud = a.tri.empty();
+	// Only point clouds pass normals; all of them must be non-zero.
+	const bool passNormals = isCloud && a.zeroNormals == 0;
+
+	switch (ID(action)) {
+	case FP_SIMPLIFY: {
+		MeshHandle in;
+		makeInput(src->cm, a, passNormals, in);
+		const vstree_simplify_params p = simplifyParams(par);
+		vstree_simplify_result* res = nullptr;
+		check(vstree_simplify(in.p, &p, progressTrampoline, &prog, &res), "simplify");
+		struct Free { vstree_simplify_result* r; ~Free() { vstree_simplify_result_free(r); } } guard{res};
+		const vstree_simplify_stats* s = vstree_simplify_result_get_stats(res);
+		MeshModel* dst = md.addNewMesh("", src->label() + " (vstree)", true);
+		fromVstree(vstree_simplify_result_get_mesh(res), dst->cm);
+		log("VS-Tree simplification: %llu -> %llu vertices, %llu -> %llu triangles, %llu clusters "
+			"(%llu V, %llu T, %llu S nodes), depth %u, %.3f s",
+			(unsigned long long)s->input_vertices, (unsigned long long)s->output_vertices,
+			(unsigned long long)s->input_triangles, (unsigned long long)s->output_triangles,
+			(unsigned long long)s->clusters, (unsigned long long)s->v_nodes,
+			(unsigned long long)s->t_nodes, (unsigned long long)s->s_nodes, s->max_depth,
+			s->seconds_total);
+		out["output_vertices"] = QVariant(qulonglong(s->output_vertices));
+		out["output_triangles"] = QVariant(qulonglong(s->output_triangles));
+		out["clusters"] = QVariant(qulonglong(s->clusters));
+		out["t_nodes"] = QVariant(qulonglong(s->t_nodes));
+		out["new_mesh_id"] = QVariant(dst->id());
+		break;
+	}
+	case FP_RECONSTRUCT: {
+		const bool estimate = par.getBool("estimate_normals");
+		if (!estimate && a.zeroNormals > 0)
+			throw MLException(QString("vstree: the point set has no normals (%1 of %2 points have a "
+									  "zero normal) and 'Estimate normals' is off; turn it on or "
+									  "compute normals first")
+								  .arg(qulonglong(a.zeroNormals))
+								  .arg(qulonglong(a.vertIndex.size())));
+		MeshHandle in;
+		// Triangles are ignored by reconstruction; normals go when every point has one.
+		Arrays pts = a;
+		pts.tri.clear();
+		makeInput(src->cm, pts, a.zeroNormals == 0, in);
+		vstree_reconstruct_params p = vstree_reconstruct_params_default();
+		p.error = double(par.getFloat("error"));
+		const int levels = par.getInt("levels");
+		if (levels < 0)
+			throw MLException(QString("vstree: levels must be in [0, 12], got %1").arg(levels));
+		p.max_levels = uint32_t(levels);
+		p.trim = float(par.getFloat("trim"));
+		vstree_reconstruct_result* res = nullptr;
+		check(vstree_reconstruct(in.p, &p, progressTrampoline, &prog, &res), "reconstruct");
+		struct Free { vstree_reconstruct_result* r; ~Free() { vstree_reconstruct_result_free(r); } } guard{res};
+		const vstree_reconstruct_stats* s = vstree_reconstruct_result_get_stats(res);
+		MeshModel* dst = md.addNewMesh("", src->label() + " (vstree reconstruction)", true);
+		fromVstree(vstree_reconstruct_result_get_mesh(res), dst->cm);
+		log("VS-Tree reconstruction: %llu points -> %llu vertices, %llu triangles; base mesh %llu "
+			"triangles (genus %d), %u levels, RMS error %.3g of the diagonal, %llu normals estimated, "
+			"%.3f s",
+			(unsigned long long)a.vertIndex.size(), (unsigned long long)s->output_vertices,
+			(unsigned long long)s->output_triangles, (unsigned long long)s->base_triangles,
+			s->base_genus, s->levels, s->final_error, (unsigned long long)s->normals_estimated,
+			s->seconds_total);
+		out["output_vertices"] = QVariant(qulonglong(s->output_vertices));
+		out["output_triangles"] = QVariant(qulonglong(s->output_triangles));
+		out["levels"] = QVariant(uint(s->levels));
+		out["base_genus"] = QVariant(int(s->base_genus));
+		out["final_error"] = QVariant(s->final_error);
+		out["normals_estimated"] = QVariant(qulonglong(s->normals_estimated));
+		out["new_mesh_id"] = QVariant(dst->id());
+		break;
+	}
+	case FP_COLOUR: {
+		MeshHandle in;
+		makeInput(src->cm, a, passNormals, in);
+		const vstree_simplify_params p = simplifyParams(par);
+		vstree_tree* tree = nullptr;
+		check(vstree_tree_build(in.p, &p, progressTrampoline, &prog, &tree), "tree_build");
+		struct Free { vstree_tree* t; ~Free() { vstree_tree_free(t); } } guard{tree};
+		const int32_t kind = par.getEnum("label") == 1 ? VSTREE_LABEL_KIND_T_NODE : VSTREE_LABEL_KIND_CLUSTER;
+		std::vector<uint32_t> labels(vstree_tree_vertex_count(tree));
+		check(vstree_tree_copy_vertex_labels(tree, kind, labels.data(), labels.size()), "copy_vertex_labels");
+		if (labels.size() != a.vertIndex.size())
+			throw MLException("vstree: label count does not match the vertex count");
+		src->updateDataMask(MeshModel::MM_VERTCOLOR);
+		size_t unlabelled = 0;
+		uint32_t maxLabel = 0;
+		for (size_t i = 0; i < labels.size(); ++i) {
+			auto& v = src->cm.vert[a.vertIndex[i]];
+			if (labels[i] == VSTREE_NO_INDEX) {
+				v.C() = vcg::Color4b(128, 128, 128, 255);
+				++unlabelled;
+				continue;
+			}
+			maxLabel = std::max(maxLabel, labels[i]);
+			const uint32_t h = hashColour(labels[i] + 1);
+			v.C() = vcg::Color4b((h & 0xff) | 0x20, ((h >> 8) & 0xff) | 0x20, ((h >> 16) & 0xff) | 0x20, 255);
+		}
+		const vstree_tree_stats* s = vstree_tree_get_stats(tree);
+		log("VS-Tree colouring by %s: %llu clusters, %llu T-nodes, %llu unlabelled vertices, max "
+			"cluster error %.3g",
+			kind == VSTREE_LABEL_KIND_T_NODE ? "T-node" : "cluster", (unsigned long long)s->clusters,
+			(unsigned long long)s->t_nodes, (unsigned long long)unlabelled, s->max_cluster_error);
+		out["clusters"] = QVariant(qulonglong(s->clusters));
+		out["t_nodes"] = QVariant(qulonglong(s->t_nodes));
+		out["unlabelled"] = QVariant(qulonglong(unlabelled));
+		break;
+	}
+	default: wrongActionCalled(action);
+	}
+	if (cb != nullptr)
+		cb(100, "vstree: done");
+	return out;
+}
+
+MESHLAB_PLUGIN_NAME_EXPORTER(FilterVstreePlugin)
