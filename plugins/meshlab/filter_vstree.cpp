@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdint>
+// pymeshlab returns only int, double, bool and string outputs: counts go out as int.
 #include <vector>
 
 namespace {
@@ -331,10 +332,10 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 			(unsigned long long)s->clusters, (unsigned long long)s->v_nodes,
 			(unsigned long long)s->t_nodes, (unsigned long long)s->s_nodes, s->max_depth,
 			s->seconds_total);
-		out["output_vertices"] = QVariant(qulonglong(s->output_vertices));
-		out["output_triangles"] = QVariant(qulonglong(s->output_triangles));
-		out["clusters"] = QVariant(qulonglong(s->clusters));
-		out["t_nodes"] = QVariant(qulonglong(s->t_nodes));
+		out["output_vertices"] = QVariant(int(s->output_vertices));
+		out["output_triangles"] = QVariant(int(s->output_triangles));
+		out["clusters"] = QVariant(int(s->clusters));
+		out["t_nodes"] = QVariant(int(s->t_nodes));
 		out["new_mesh_id"] = QVariant(dst->id());
 		break;
 	}
@@ -371,12 +372,12 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 			(unsigned long long)s->output_triangles, (unsigned long long)s->base_triangles,
 			s->base_genus, s->levels, s->final_error, (unsigned long long)s->normals_estimated,
 			s->seconds_total);
-		out["output_vertices"] = QVariant(qulonglong(s->output_vertices));
-		out["output_triangles"] = QVariant(qulonglong(s->output_triangles));
-		out["levels"] = QVariant(uint(s->levels));
+		out["output_vertices"] = QVariant(int(s->output_vertices));
+		out["output_triangles"] = QVariant(int(s->output_triangles));
+		out["levels"] = QVariant(int(s->levels));
 		out["base_genus"] = QVariant(int(s->base_genus));
 		out["final_error"] = QVariant(s->final_error);
-		out["normals_estimated"] = QVariant(qulonglong(s->normals_estimated));
+		out["normals_estimated"] = QVariant(int(s->normals_estimated));
 		out["new_mesh_id"] = QVariant(dst->id());
 		break;
 	}
@@ -411,9 +412,9 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 			"cluster error %.3g",
 			kind == VSTREE_LABEL_KIND_T_NODE ? "T-node" : "cluster", (unsigned long long)s->clusters,
 			(unsigned long long)s->t_nodes, (unsigned long long)unlabelled, s->max_cluster_error);
-		out["clusters"] = QVariant(qulonglong(s->clusters));
-		out["t_nodes"] = QVariant(qulonglong(s->t_nodes));
-		out["unlabelled"] = QVariant(qulonglong(unlabelled));
+		out["clusters"] = QVariant(int(s->clusters));
+		out["t_nodes"] = QVariant(int(s->t_nodes));
+		out["unlabelled"] = QVariant(int(unlabelled));
 		break;
 	}
 	default: wrongActionCalled(action);

@@ -1,0 +1,190 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Tests of the vstree MeshLab filter plugin inside pymeshlab (2022.2.post4 and 2025.7.post1).
+
+Runs under pytest or as a plain script:  python test_vstree_meshlab.py
+The plugin is taken from $VSTREE_MESHLAB_PLUGIN (tests/meshlab/run.sh sets it).
+"""
+import os
+import sys
+import time
+
+import numpy as np
+import pymeshlab
+
+PLUGIN = os.environ["VSTREE_MESHLAB_PLUGIN"]
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "data")
+SIMPLIFY = "vstree_clustering_simplification"
+RECONSTRUCT = "vstree_surface_reconstruction"
+COLOUR = "vstree_cluster_colouring"
+
+_nplugins = getattr(pymeshlab, "plugin_number", None) or pymeshlab.number_plugins
+_before = _nplugins()
+pymeshlab.load_plugin(PLUGIN)
+_after = _nplugins()
+
+
+def nmeshes(ms):
+    return (getattr(ms, "mesh_number", None) or ms.number_meshes)()
+
+
+def topo(ms):
+    return ms.apply_filter("get_topological_measures")
+
+
+def sphere(ms):
+    ms.create_sphere(subdiv=4)  # 2562 vertices, 5120 faces
+    return ms.current_mesh()
+
+
+def sphere_points(n=3000, normals=True):
+    rng = np.random.default_rng(1)
+    p = rng.normal(size=(n, 3))
+    p /= np.linalg.norm(p, axis=1, keepdims=True)
+    if normals:
+        return pymeshlab.Mesh(vertex_matrix=p.astype(np.float64), v_normals_matrix=p.astype(np.float64))
+    return pymeshlab.Mesh(vertex_matrix=p.astype(np.float64))
+
+
+def expect_error(ms, name, fragment, **kw):
+    try:
+        ms.apply_filter(name, **kw)
+    except pymeshlab.PyMeshLabException as e:
+        msg = str(e)
+        assert fragment in msg, msg
+        print("  error text:", msg.replace("\n", " | "))
+        return msg
+    raise AssertionError(f"{name}({kw}) did not raise")
+
+
+def test_plugin_loaded():
+    assert _after == _before + 1, (_before, _after)
+    names = pymeshlab.filter_list()
+    for n in (SIMPLIFY, RECONSTRUCT, COLOUR):
+        assert n in names, n
+
+
+def test_simplify_sphere_new_layer():
+    ms = pymeshlab.MeshSet()
+    src = sphere(ms)
+    src_id = ms.current_mesh_id()
+    nv, nf = src.vertex_number(), src.face_number()
+    out = ms.apply_filter(SIMPLIFY, error=1e-3)
+    assert nmeshes(ms) == 2 and ms.current_mesh_id() != src_id
+    m = ms.current_mesh()
+    print(f"  sphere {nv} v / {nf} f -> {m.vertex_number()} v / {m.face_number()} f, {out}")
+    assert 10 < m.vertex_number() < nv and 10 < m.face_number() < nf
+    assert m.vertex_number() == out["output_vertices"] and m.face_number() == out["output_triangles"]
+    assert ms.mesh(src_id).vertex_number() == nv  # source untouched
+    # coarser bound -> fewer vertices
+    ms.set_current_mesh(src_id)
+    ms.apply_filter(SIMPLIFY, error=1e-2)
+    assert ms.current_mesh().vertex_number() < m.vertex_number()
+
+
+def test_simplify_options():
+    ms = pymeshlab.MeshSet()
+    sphere(ms)
+    src_id = ms.current_mesh_id()
+    for kw in (dict(tree_kind="Octree"), dict(sampling="Face centers"),
+               dict(metric="L2,1 (normal deviation)", error=0.05),
+               dict(metric="Density (samples)", error=20), dict(d_a=0.5, d_d=0.1)):
+        ms.set_current_mesh(src_id)
+        out = ms.apply_filter(SIMPLIFY, **kw)
+        assert ms.current_mesh().face_number() > 0, kw
+        print(f"  {kw}: {out['output_vertices']} v / {out['output_triangles']} f")
+
+
+def test_simplify_point_cloud_with_normals():
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(sphere_points(3000, normals=True), "cloud")
+    out = ms.apply_filter(SIMPLIFY, error=1e-3)
+    m = ms.current_mesh()
+    assert nmeshes(ms) == 2 and m.face_number() == 0 and 0 < m.vertex_number() < 3000, out
+
+
+def test_simplify_errors():
+    ms = pymeshlab.MeshSet()
+    sphere(ms)
+    msg = expect_error(ms, SIMPLIFY, "error", error=-1.0)
+    assert "vstree simplify failed" in msg
+    expect_error(ms, SIMPLIFY, "max_depth", max_depth=99)
+    assert nmeshes(ms) == 1  # no layer on failure
+    ms.add_mesh(sphere_points(500, normals=False), "bare")
+    expect_error(ms, SIMPLIFY, "normal")
+
+
+def test_reconstruct_closed_watertight():
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(sphere_points(4000, normals=False), "cloud")  # no normals: estimated
+    out = ms.apply_filter(RECONSTRUCT, levels=3)
+    m = ms.current_mesh()
+    assert nmeshes(ms) == 2 and m.face_number() > 100, out
+    t = topo(ms)
+    print(f"  reconstruction {m.vertex_number()} v / {m.face_number()} f, {out}, topology {t}")
+    assert t["boundary_edges"] == 0 and t["non_two_manifold_edges"] == 0
+    assert t["is_mesh_two_manifold"] and t["genus"] == 0
+    assert out["normals_estimated"] == 4000
+
+
+def test_reconstruct_with_given_normals_and_trim():
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(sphere_points(3000, normals=True), "cloud")
+    out = ms.apply_filter(RECONSTRUCT, estimate_normals=False, levels=2, trim=2.0)
+    assert ms.current_mesh().face_number() > 100 and out["normals_estimated"] == 0, out
+
+
+def test_reconstruct_errors():
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(sphere_points(500, normals=False), "bare")
+    expect_error(ms, RECONSTRUCT, "has no normals", estimate_normals=False)
+    expect_error(ms, RECONSTRUCT, "error", error=-1.0)
+    expect_error(ms, RECONSTRUCT, "levels", levels=13)
+    assert nmeshes(ms) == 1
+
+
+def test_colouring():
+    ms = pymeshlab.MeshSet()
+    src = sphere(ms)
+    out = ms.apply_filter(COLOUR, error=1e-3)
+    m = ms.current_mesh()
+    assert nmeshes(ms) == 1 and m.has_vertex_color()
+    cols = np.unique(m.vertex_color_array() if hasattr(m, "vertex_color_array") else m.vertex_color_matrix(), axis=0)
+    print(f"  {len(cols)} distinct colours, {out}")
+    assert len(cols) > 10 and out["clusters"] > 10
+    out_t = ms.apply_filter(COLOUR, label="T-node")
+    assert out_t["t_nodes"] > 0, out_t
+    expect_error(ms, COLOUR, "error", error=0.0)
+
+
+def test_real_model():
+    path = os.path.join(DATA, "bunny_zipper.ply")
+    if not os.path.exists(path):
+        print("  skipped: no", path)
+        return
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(path)
+    nv = ms.current_mesh().vertex_number()
+    t = time.time()
+    out = ms.apply_filter(SIMPLIFY, error=1e-4)
+    m = ms.current_mesh()
+    print(f"  bunny_zipper {nv} v -> {m.vertex_number()} v / {m.face_number()} f in {time.time() - t:.2f}s")
+    assert 100 < m.vertex_number() < nv
+    ms.set_current_mesh(0)
+    ms.apply_filter(COLOUR, error=1e-4)
+    assert ms.mesh(0).has_vertex_color()
+
+
+if __name__ == "__main__":
+    failed = 0
+    for name, fn in list(globals().items()):
+        if name.startswith("test_") and callable(fn):
+            t = time.time()
+            try:
+                fn()
+                print(f"PASS {name} ({time.time() - t:.2f}s)")
+            except Exception as e:  # report and go on
+                failed += 1
+                print(f"FAIL {name}: {type(e).__name__}: {e}")
+    print(f"pymeshlab {pymeshlab.__version__ if hasattr(pymeshlab, '__version__') else ''}: "
+          f"{'ALL PASSED' if failed == 0 else f'{failed} FAILED'}")
+    sys.exit(1 if failed else 0)
