@@ -12,7 +12,7 @@ import numpy as np
 import pymeshlab
 
 PLUGIN = os.environ["VSTREE_MESHLAB_PLUGIN"]
-DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "data")
+DATA = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared", "data"))
 SIMPLIFY = "vstree_clustering_simplification"
 RECONSTRUCT = "vstree_surface_reconstruction"
 COLOUR = "vstree_cluster_colouring"
@@ -45,7 +45,14 @@ def sphere_points(n=3000, normals=True):
     return pymeshlab.Mesh(vertex_matrix=p.astype(np.float64))
 
 
+# pymeshlab (both versions) leaves VerbosityManager::staticLogger pointing at the MeshSet's log
+# when a filter throws; destroying that MeshSet and loading a file later then crashes. Keep every
+# MeshSet that saw a failing filter alive until the process ends.
+_KEEP_ALIVE = []
+
+
 def expect_error(ms, name, fragment, **kw):
+    _KEEP_ALIVE.append(ms)
     try:
         ms.apply_filter(name, **kw)
     except pymeshlab.PyMeshLabException as e:
