@@ -5,6 +5,7 @@ Runs under pytest or as a plain script:  python test_vstree_meshlab.py
 The plugin is taken from $VSTREE_MESHLAB_PLUGIN (tests/meshlab/run.sh sets it).
 """
 import os
+import subprocess
 import sys
 import time
 
@@ -163,6 +164,28 @@ def test_colouring():
     expect_error(ms, COLOUR, "error", error=0.0)
 
 
+VERBOSE_SCRIPT = """
+import os, pymeshlab
+pymeshlab.load_plugin(os.environ["VSTREE_MESHLAB_PLUGIN"])
+ms = pymeshlab.MeshSet(verbose=True)
+ms.create_sphere(subdiv=4)
+ms.apply_filter("vstree_clustering_simplification", error=1e-3)
+ms.apply_filter("vstree_surface_reconstruction", levels=1)
+"""
+
+
+def test_verbose_log_and_progress():
+    # pymeshlab buffers the verbose log (plugin log() lines and progress) on stderr until the
+    # process ends, so run it in a child process and read its stderr.
+    r = subprocess.run([sys.executable, "-c", VERBOSE_SCRIPT], capture_output=True, text=True,
+                       timeout=120, check=True)
+    lines = [l for l in r.stderr.splitlines() if l.startswith("LOG:")]
+    print("  " + "\n  ".join(lines[:3] + ["..."] + lines[-2:]))
+    assert "VS-Tree simplification: 2562 -> 92 vertices, 5120 -> 180 triangles" in r.stderr, r.stderr
+    assert "VS-Tree reconstruction:" in r.stderr, r.stderr
+    assert "building tree    [ 0% ]" in r.stderr and "done    [ 100% ]" in r.stderr, r.stderr
+
+
 def test_real_model():
     path = os.path.join(DATA, "bunny_zipper.ply")
     if not os.path.exists(path):
@@ -179,6 +202,16 @@ def test_real_model():
     ms.set_current_mesh(0)
     ms.apply_filter(COLOUR, error=1e-4)
     assert ms.mesh(0).has_vertex_color()
+    path = os.path.join(DATA, "armadillo_points_normals.ply")
+    if os.path.exists(path):
+        ms.load_new_mesh(path)
+        n = ms.current_mesh().vertex_number()
+        t = time.time()
+        out = ms.apply_filter(RECONSTRUCT, estimate_normals=False, levels=3)
+        m = ms.current_mesh()
+        print(f"  armadillo {n} points -> {m.vertex_number()} v / {m.face_number()} f in "
+              f"{time.time() - t:.2f}s, {out}")
+        assert m.face_number() > 1000 and topo(ms)["boundary_edges"] == 0
 
 
 if __name__ == "__main__":
@@ -192,6 +225,6 @@ if __name__ == "__main__":
             except Exception as e:  # report and go on
                 failed += 1
                 print(f"FAIL {name}: {type(e).__name__}: {e}")
-    print(f"pymeshlab {pymeshlab.__version__ if hasattr(pymeshlab, '__version__') else ''}: "
+    print(f"pymeshlab {os.path.dirname(pymeshlab.__file__)}: "
           f"{'ALL PASSED' if failed == 0 else f'{failed} FAILED'}")
     sys.exit(1 if failed else 0)
