@@ -16,7 +16,12 @@ for v in $versions; do
 		VSTREE_NO_BUILD=1 bash plugins/meshlab/build.sh "$v"
 	fi
 	first=0
-	echo "== MeshLab plugin: pymeshlab $v: tests"
-	VSTREE_MESHLAB_PLUGIN="target/meshlab/$v/pkg/libfilter_vstree.so" \
+	echo "== MeshLab plugin: pymeshlab $v: tests (plugin from the unpacked package)"
+	# the package must work on its own: plugin + libvstree.so.0 found through RUNPATH $ORIGIN
+	unpacked="target/meshlab/$v/unpacked"
+	rm -rf "$unpacked"
+	mkdir -p "$unpacked"
+	tar -xzf "target/meshlab/$v/vstree-meshlab-$v.tar.gz" -C "$unpacked"
+	VSTREE_MESHLAB_PLUGIN="$unpacked/libfilter_vstree.so" \
 		"target/meshlab/$v/venv/bin/python" tests/meshlab/test_vstree_meshlab.py
 done
