@@ -133,7 +133,7 @@ void fromVstree(const vstree_mesh* vm, CMeshO& out)
 // The vstree input mesh of a MeshLab layer. Triangle meshes go without normals (vstree takes
 // area-weighted ones from the triangles); point clouds go with their normals when every point
 // has one, else without (simplification then reports the missing normals).
-void makeInput(const CMeshO& m, const Arrays& a, bool withNormals, MeshHandle& h)
+void makeInput(const Arrays& a, bool withNormals, MeshHandle& h)
 {
 	if (a.vertIndex.empty())
 		throw MLException("vstree: the current layer has no vertices");
@@ -141,7 +141,6 @@ void makeInput(const CMeshO& m, const Arrays& a, bool withNormals, MeshHandle& h
 	check(vstree_mesh_create(a.pos.data(), a.vertIndex.size(), n, a.tri.empty() ? nullptr : a.tri.data(),
 			  a.tri.size() / 3, &h.p),
 		"mesh_create");
-	(void)m;
 }
 
 vstree_simplify_params simplifyParams(const RichParameterList& par)
@@ -317,7 +316,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 	switch (ID(action)) {
 	case FP_SIMPLIFY: {
 		MeshHandle in;
-		makeInput(src->cm, a, passNormals, in);
+		makeInput(a, passNormals, in);
 		const vstree_simplify_params p = simplifyParams(par);
 		vstree_simplify_result* res = nullptr;
 		check(vstree_simplify(in.p, &p, progressTrampoline, &prog, &res), "simplify");
@@ -351,7 +350,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 		// Triangles are ignored by reconstruction; normals go when every point has one.
 		Arrays pts = a;
 		pts.tri.clear();
-		makeInput(src->cm, pts, a.zeroNormals == 0, in);
+		makeInput(pts, a.zeroNormals == 0, in);
 		vstree_reconstruct_params p = vstree_reconstruct_params_default();
 		p.error = double(par.getFloat("error"));
 		const int levels = par.getInt("levels");
@@ -383,7 +382,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 	}
 	case FP_COLOUR: {
 		MeshHandle in;
-		makeInput(src->cm, a, passNormals, in);
+		makeInput(a, passNormals, in);
 		const vstree_simplify_params p = simplifyParams(par);
 		vstree_tree* tree = nullptr;
 		check(vstree_tree_build(in.p, &p, progressTrampoline, &prog, &tree), "tree_build");

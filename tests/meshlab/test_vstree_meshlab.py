@@ -150,6 +150,17 @@ def test_reconstruct_errors():
     assert nmeshes(ms) == 1
 
 
+def test_bad_geometry_raises_not_crashes():
+    ms = pymeshlab.MeshSet()
+    v = np.array([[0, 0, 0], [0, 0, 0], [0, 0, 0]], dtype=np.float64)  # one degenerate triangle
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=v, face_matrix=np.array([[0, 1, 2]], dtype=np.int32)), "flat")
+    expect_error(ms, SIMPLIFY, "vstree simplify failed")
+    expect_error(ms, COLOUR, "vstree tree_build failed")
+    ms.add_mesh(sphere_points(5, normals=True), "five")  # fewer than 10 points
+    expect_error(ms, RECONSTRUCT, "vstree reconstruct failed")
+    assert nmeshes(ms) == 2
+
+
 def test_colouring():
     ms = pymeshlab.MeshSet()
     src = sphere(ms)
