@@ -43,7 +43,7 @@ def status():
         b = binding()
     except VstreeUnavailable as e:
         return False, str(e)
-    return True, "libvstree %s (ABI %d)" % (b.version().decode(), b.ABI_VERSION)
+    return True, "libvstree %s (ABI %d)" % (b.version, b.ABI_VERSION)
 
 
 # ---- Blender mesh <-> numpy ----------------------------------------------------------------
