@@ -40,3 +40,4 @@ bash tests/python/run.sh
 
 echo "== C API and readers: bounded fuzzing"
 bash fuzz/run.sh 10
+bash tests/blender/run.sh

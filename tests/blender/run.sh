@@ -46,4 +46,5 @@ for v in $versions; do
         echo "tests/blender: pytest in bpy $v exited with status $status" >&2
         exit "$status"
     fi
+    "$root/target/blender-venv-$v/bin/python" tests/blender/legacy_check.py "$root/target/blender/stage"
 done

@@ -231,3 +231,29 @@ def test_imported_ply_model(scene):
     bpy.context.view_layer.objects.active = ob
     assert bpy.ops.vstree.show_clusters(error=1e-4) == {'FINISHED'}
     assert len(ob.data.color_attributes["vstree_cluster"].data) == v0
+
+
+def test_missing_library_is_reported(scene, addon, monkeypatch):
+    """A library that cannot be loaded (missing, or another ABI: both are ImportError in the
+    binding) gives a clear operator error; the add-on stays registered and recovers."""
+    import sys
+
+    core = addon.core
+    pkg = core.__package__ + ".vstree"
+    saved = {k: sys.modules.pop(k) for k in list(sys.modules) if k == pkg or k.startswith(pkg + ".")}
+    saved_binding = core._BINDING
+    monkeypatch.setenv("VSTREE_LIBRARY", "/nonexistent/libvstree.so")
+    core._BINDING = None
+    try:
+        bpy.ops.mesh.primitive_uv_sphere_add()
+        with pytest.raises(RuntimeError, match="Error: VS-Tree: VS-Tree native library unavailable: .*nonexistent"):
+            bpy.ops.vstree.simplify()
+        ok, msg = core.status()
+        assert not ok and "unavailable" in msg
+        assert len(bpy.data.objects) == 1
+    finally:
+        for k in [k for k in sys.modules if k == pkg or k.startswith(pkg + ".")]:
+            del sys.modules[k]
+        sys.modules.update(saved)
+        core._BINDING = saved_binding
+    assert bpy.ops.vstree.simplify() == {'FINISHED'}
