@@ -120,10 +120,12 @@ def source_mesh(context, ob, apply_modifiers):
     return me, ob_eval.to_mesh_clear
 
 
-def simplify_object(context, ob, params, apply_modifiers=True, in_place=False, progress=None):
-    """Simplifies mesh object ``ob``; returns (object written, stats). ``params`` are the
-    binding's keyword parameters (error, tree_kind, metric, ...)."""
-    vs = binding()
+# Each operation is read (main thread: Blender data -> numpy), compute (any thread: only numpy
+# and the library, which releases the GIL) and write (main thread: numpy -> Blender data). The
+# GUI runs compute on a worker thread; execute() and the *_object functions run all three.
+
+
+def read_simplify(context, ob, apply_modifiers):
     me, cleanup = source_mesh(context, ob, apply_modifiers)
     try:
         positions, triangles = mesh_arrays(me)
@@ -133,11 +135,20 @@ def simplify_object(context, ob, params, apply_modifiers=True, in_place=False, p
         raise ValueError("'%s' has no vertices" % ob.name)
     if len(triangles) == 0:
         raise ValueError("'%s' has no faces: use Reconstruct for point clouds" % ob.name)
+    return positions, triangles
+
+
+def compute_simplify(data, params, progress=None):
+    vs = binding()
+    positions, triangles = data
     with vs.Mesh(positions, triangles) as m:
         result = vs.simplify(m, progress=progress, **params)
     with result.mesh as out:
-        new_p, new_t = out.positions, out.triangles
-    # Only now is the scene changed: a cancel or an error above leaves it untouched.
+        return out.positions, out.triangles, result.stats
+
+
+def write_simplify(context, ob, out, apply_modifiers=True, in_place=False):
+    new_p, new_t, _ = out
     new = new_mesh(ob.data.name + "_vstree", new_p, new_t)
     if in_place:
         old = ob.data
@@ -146,51 +157,80 @@ def simplify_object(context, ob, params, apply_modifiers=True, in_place=False, p
             ob.modifiers.clear()
         if old.users == 0:
             bpy.data.meshes.remove(old)
-        target = ob
-    else:
-        target = bpy.data.objects.new(ob.name + "_vstree", new)
-        target.matrix_world = ob.matrix_world.copy()
-        context.collection.objects.link(target)
-    return target, result.stats
+        return ob
+    target = bpy.data.objects.new(ob.name + "_vstree", new)
+    target.matrix_world = ob.matrix_world.copy()
+    context.collection.objects.link(target)
+    return target
+
+
+def simplify_object(context, ob, params, apply_modifiers=True, in_place=False, progress=None):
+    """Simplifies mesh object ``ob``; returns (object written, stats). ``params`` are the
+    binding's keyword parameters (error, tree_kind, metric, ...). The scene is only written
+    after the library call returned, so a cancel or an error leaves it untouched."""
+    binding()
+    out = compute_simplify(read_simplify(context, ob, apply_modifiers), params, progress)
+    return write_simplify(context, ob, out, apply_modifiers, in_place), out[2]
+
+
+def read_cloud(ob):
+    me = ob.data
+    positions, _ = mesh_arrays(me)
+    if len(me.polygons):
+        raise ValueError("'%s' has faces: Reconstruct takes a point cloud (vertices only)" % ob.name)
+    if len(positions) < 10:
+        raise ValueError("'%s' has %d points; reconstruction needs at least 10" % (ob.name, len(positions)))
+    return positions, point_normals(me)
+
+
+def compute_reconstruct(data, params, progress=None):
+    vs = binding()
+    positions, normals = data
+    result = vs.reconstruct(positions, normals, progress=progress, **params)
+    with result.mesh as out:
+        return out.positions, out.triangles, result.stats
+
+
+def write_reconstruct(context, ob, out):
+    new_p, new_t, _ = out
+    new = new_mesh(ob.name + "_surface", new_p, new_t)
+    target = bpy.data.objects.new(ob.name + "_surface", new)
+    target.matrix_world = ob.matrix_world.copy()
+    context.collection.objects.link(target)
+    return target
 
 
 def reconstruct_object(context, ob, params, progress=None):
     """Reconstructs a surface from the vertices of mesh object ``ob`` (normals from its point
     attribute "normal" when present, else estimated); returns (new object, stats)."""
-    vs = binding()
-    me = ob.data
-    positions, _ = mesh_arrays(me)
-    if len(me.polygons):
-        raise ValueError("'%s' has faces: Reconstruct takes a point cloud (vertices only)" % ob.name)
-    normals = point_normals(me)
-    if len(positions) < 10:
-        raise ValueError("'%s' has %d points; reconstruction needs at least 10" % (ob.name, len(positions)))
-    result = vs.reconstruct(positions, normals, progress=progress, **params)
-    with result.mesh as out:
-        new_p, new_t = out.positions, out.triangles
-    new = new_mesh(ob.name + "_surface", new_p, new_t)
-    target = bpy.data.objects.new(ob.name + "_surface", new)
-    target.matrix_world = ob.matrix_world.copy()
-    context.collection.objects.link(target)
-    return target, result.stats
+    binding()
+    out = compute_reconstruct(read_cloud(ob), params, progress)
+    return write_reconstruct(context, ob, out), out[2]
 
 
-def cluster_colors(context, ob, params, kind="cluster", name="vstree_cluster", progress=None):
-    """Adds (or replaces) a FLOAT_COLOR point attribute ``name`` on ``ob``'s mesh: one colour per
-    cluster (``kind="cluster"``) or T-node (``"t_node"``) of the tree simplification would use.
-    Reads the object's own mesh (no modifiers) so that the labels match its vertices. Returns
-    (attribute, number of distinct labels)."""
-    vs = binding()
+def read_labels(ob):
     me = ob.data
     positions, triangles = mesh_arrays(me)
     if len(positions) == 0:
         raise ValueError("'%s' has no vertices" % ob.name)
     normals = point_normals(me) if len(triangles) == 0 else None
+    return positions, triangles, normals
+
+
+def compute_labels(data, params, kind="cluster", progress=None):
+    vs = binding()
+    positions, triangles, normals = data
     with vs.Mesh(positions, triangles, normals) as m:
         if len(triangles) == 0 and normals is None:
             m = vs.estimate_normals(m, progress=progress).mesh
         with vs.Tree(m, progress=progress, **params) as tree:
-            labels = tree.vertex_labels(kind)
+            return tree.vertex_labels(kind)
+
+
+def write_colors(ob, labels, name="vstree_cluster"):
+    me = ob.data
+    if len(labels) != len(me.vertices):
+        raise ValueError("'%s' changed while its clusters were computed" % ob.name)
     rgba = label_colors(labels)
     old = me.color_attributes.get(name)
     if old is not None:
@@ -200,3 +240,13 @@ def cluster_colors(context, ob, params, kind="cluster", name="vstree_cluster", p
     me.color_attributes.active_color = attr
     me.update()
     return attr, int(len(np.unique(labels[labels != 0xFFFFFFFF])))
+
+
+def cluster_colors(context, ob, params, kind="cluster", name="vstree_cluster", progress=None):
+    """Adds (or replaces) a FLOAT_COLOR point attribute ``name`` on ``ob``'s mesh: one colour per
+    cluster (``kind="cluster"``) or T-node (``"t_node"``) of the tree simplification would use.
+    Reads the object's own mesh (no modifiers) so that the labels match its vertices. Returns
+    (attribute, number of distinct labels)."""
+    binding()
+    labels = compute_labels(read_labels(ob), params, kind, progress)
+    return write_colors(ob, labels, name)
