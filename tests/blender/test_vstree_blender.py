@@ -257,3 +257,38 @@ def test_missing_library_is_reported(scene, addon, monkeypatch):
         sys.modules.update(saved)
         core._BINDING = saved_binding
     assert bpy.ops.vstree.simplify() == {'FINISHED'}
+
+
+def test_worker_thread_compute_and_cancel(scene, addon):
+    """What the GUI's modal path does: read on the main thread, compute on a worker thread with
+    the operators' progress object, Esc (the cancel event) stops it; then write."""
+    import threading
+
+    core = addon.core
+    bpy.ops.mesh.primitive_torus_add(major_segments=96, minor_segments=32)
+    ob = bpy.context.active_object
+    data = core.read_simplify(bpy.context, ob, True)
+    box = {}
+
+    def run(progress):
+        try:
+            box["out"] = core.compute_simplify(data, {"error": 1e-3}, progress)
+        except Exception as e:
+            box["error"] = e
+
+    progress = addon._Progress(None, threading.Event())
+    t = threading.Thread(target=run, args=(progress,))
+    t.start()
+    t.join(60)
+    assert "error" not in box, box
+    assert progress.fraction == 1.0 and progress.stage
+    target = core.write_simplify(bpy.context, ob, box["out"])
+    assert 0 < len(target.data.vertices) < len(ob.data.vertices)
+
+    box.clear()
+    cancel = threading.Event()
+    cancel.set()
+    t = threading.Thread(target=run, args=(addon._Progress(None, cancel),))
+    t.start()
+    t.join(60)
+    assert isinstance(box.get("error"), core.binding().CancelledError), box

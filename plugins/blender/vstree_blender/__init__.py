@@ -16,6 +16,8 @@ bl_info = {
     "category": "Mesh",
 }
 
+import threading
+
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
@@ -88,11 +90,27 @@ def _error_prop(default):
 
 
 class _Worker:
-    """Shared run logic: execute() runs the work synchronously with window_manager progress
-    (also what INVOKE_DEFAULT does headless). No modal/threaded GUI path yet."""
+    """Shared run logic. Each operator says how to read its input (main thread), compute
+    (numpy + the library only: any thread) and write the result (main thread).
+
+    execute() runs the three steps synchronously with window_manager progress; it is what
+    scripts and INVOKE_DEFAULT in background mode run. invoke() in the GUI reads, computes on a
+    worker thread (the library releases the GIL) while a timer updates the progress and Esc
+    cancels, then writes. Either way the scene is written only once the library is done."""
+
+    def _read(self, context, ob):
+        raise NotImplementedError
+
+    def _native(self, data, progress):
+        raise NotImplementedError
+
+    def _write(self, context, ob, out):
+        raise NotImplementedError
 
     def _compute(self, context, progress):
-        raise NotImplementedError
+        core.binding()
+        ob = context.active_object
+        return self._write(context, ob, self._native(self._read(context, ob), progress))
 
     def _finish(self, context, value):
         raise NotImplementedError
@@ -114,6 +132,62 @@ class _Worker:
             return self._fail(e)
         finally:
             wm.progress_end()
+        return self._finish(context, value)
+
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        ob = context.active_object
+        try:
+            core.binding()
+            data = self._read(context, ob)
+        except Exception as e:
+            return self._fail(e)
+        self._object_name = ob.name
+        self._cancel = threading.Event()
+        self._progress = _Progress(None, self._cancel)
+        self._box = {}
+
+        def run():
+            try:
+                self._box["out"] = self._native(data, self._progress)
+            except Exception as e:  # handed to the main thread
+                self._box["error"] = e
+
+        self._thread = threading.Thread(target=run, name="vstree", daemon=True)
+        self._thread.start()
+        wm = context.window_manager
+        wm.progress_begin(0.0, 1.0)
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.modal_handler_add(self)
+        return {'RUNNING_MODAL'}
+
+    def modal(self, context, event):
+        if event.type == 'ESC':
+            self._cancel.set()
+            return {'RUNNING_MODAL'}
+        if event.type != 'TIMER':
+            return {'PASS_THROUGH'}
+        wm = context.window_manager
+        if self._thread.is_alive():
+            wm.progress_update(self._progress.fraction)
+            context.workspace.status_text_set(
+                "VS-Tree: %s %d%% (Esc cancels)" % (self._progress.stage, int(100 * self._progress.fraction))
+            )
+            return {'RUNNING_MODAL'}
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+        if "error" in self._box:
+            return self._fail(self._box["error"])
+        ob = bpy.data.objects.get(self._object_name)
+        if ob is None or ob.type != 'MESH':
+            self.report({'ERROR'}, "VS-Tree: '%s' was removed while computing" % self._object_name)
+            return {'CANCELLED'}
+        try:
+            value = self._write(context, ob, self._box["out"])
+        except Exception as e:
+            return self._fail(e)
         return self._finish(context, value)
 
 
@@ -148,11 +222,14 @@ class VSTREE_OT_simplify(_Worker, bpy.types.Operator):
     def _params(self):
         return dict(error=self.error, tree_kind=self.tree_kind, metric=self.metric, threads=self.threads)
 
-    def _compute(self, context, progress):
-        ob = context.active_object
-        return core.simplify_object(
-            context, ob, self._params(), self.apply_modifiers, self.in_place, progress
-        )
+    def _read(self, context, ob):
+        return core.read_simplify(context, ob, self.apply_modifiers)
+
+    def _native(self, data, progress):
+        return core.compute_simplify(data, self._params(), progress)
+
+    def _write(self, context, ob, out):
+        return core.write_simplify(context, ob, out, self.apply_modifiers, self.in_place), out[2]
 
     def _finish(self, context, value):
         target, stats = value
@@ -192,12 +269,18 @@ class VSTREE_OT_reconstruct(_Worker, bpy.types.Operator):
     def poll(cls, context):
         return _is_mesh(context)
 
-    def _compute(self, context, progress):
+    def _read(self, context, ob):
+        return core.read_cloud(ob)
+
+    def _native(self, data, progress):
         params = dict(
             error=self.error, max_levels=self.max_levels, max_grid_depth=self.max_grid_depth,
             trim=self.trim, orient=self.orient, neighbours=self.neighbours, threads=self.threads,
         )
-        return core.reconstruct_object(context, context.active_object, params, progress)
+        return core.compute_reconstruct(data, params, progress)
+
+    def _write(self, context, ob, out):
+        return core.write_reconstruct(context, ob, out), out[2]
 
     def _finish(self, context, value):
         target, stats = value
@@ -229,11 +312,17 @@ class VSTREE_OT_show_clusters(_Worker, bpy.types.Operator):
     def poll(cls, context):
         return _is_mesh(context)
 
-    def _compute(self, context, progress):
+    def _read(self, context, ob):
         if not self.attribute:
             raise ValueError("the attribute name is empty")
+        return core.read_labels(ob)
+
+    def _native(self, data, progress):
         params = dict(error=self.error, tree_kind=self.tree_kind, metric=self.metric)
-        return core.cluster_colors(context, context.active_object, params, self.kind, self.attribute, progress)
+        return core.compute_labels(data, params, self.kind, progress)
+
+    def _write(self, context, ob, out):
+        return core.write_colors(ob, out, self.attribute)
 
     def _finish(self, context, value):
         attr, count = value
