@@ -1,11 +1,14 @@
 """Loads the staged add-on folder as a legacy add-on (bl_info, addon_utils) in its own process:
 registration must work, and the operators must run.  Usage: python legacy_check.py STAGE_PARENT"""
 
+import atexit
 import os
+import shutil
 import sys
 import tempfile
 
 tmp = tempfile.mkdtemp(prefix="vstree_bpy_legacy_")
+atexit.register(shutil.rmtree, tmp, ignore_errors=True)
 os.environ["BLENDER_USER_RESOURCES"] = os.path.join(tmp, "user")
 os.environ["XDG_CACHE_HOME"] = os.path.join(tmp, "cache")
 
