@@ -40,4 +40,9 @@ bash tests/python/run.sh
 
 echo "== C API and readers: bounded fuzzing"
 bash fuzz/run.sh 10
+
+echo "== MeshLab plugin in pymeshlab 2022.2.post4 and 2025.7.post1"
 bash tests/meshlab/run.sh
+
+echo "== Blender extension in bpy 4.2.23 and 5.0.1"
+bash tests/blender/run.sh
