@@ -11,6 +11,14 @@
 
 #include <vstree.h>
 
+// MeshLab 2025 renamed RichAbsPerc (a length given as an absolute value or a percentage of the
+// bounding-box diagonal) to RichPercentage.
+#if __has_include(<common/parameters/rich_parameters.h>)
+using DistanceParam = RichPercentage;
+#else
+using DistanceParam = RichAbsPerc;
+#endif
+
 #include <cmath>
 #include <cstdint>
 // pymeshlab returns only int, double, bool and string outputs: counts go out as int.
@@ -143,7 +151,27 @@ void makeInput(const Arrays& a, bool withNormals, MeshHandle& h)
 		"mesh_create");
 }
 
-vstree_simplify_params simplifyParams(const RichParameterList& par)
+// The L2 bound from the "distance" parameter when it is set: every sample's tangent plane then
+// passes within that distance of its cluster's point, since the bound e on the summed squared
+// plane distances over diag^2 gives each one at most sqrt(e) * diag. Otherwise "error" as given.
+double l2Bound(const RichParameterList& par, double diagonal)
+{
+	const double d = double(par.getAbsPerc("distance"));
+	if (d <= 0 || diagonal <= 0)
+		return double(par.getFloat("error"));
+	return (d / diagonal) * (d / diagonal);
+}
+
+void addDistanceParam(RichParameterList& pl, double diagonal)
+{
+	pl.addParam(DistanceParam("distance", 0, 0, Scalarm(diagonal), "Max plane distance",
+		"The error bound as a length (an absolute value, or a percentage of the bounding-box "
+		"diagonal): every sample's tangent plane passes within this distance of its cluster's "
+		"point. When set (> 0) it replaces 'Error bound' with (distance / diagonal)^2; L2 metric "
+		"only. 0 uses 'Error bound'."));
+}
+
+vstree_simplify_params simplifyParams(const RichParameterList& par, double diagonal)
 {
 	vstree_simplify_params p = vstree_simplify_params_default();
 	p.tree_kind = par.getEnum("tree_kind") == 1 ? VSTREE_TREE_KIND_OCTREE : VSTREE_TREE_KIND_VS_TREE;
@@ -154,19 +182,25 @@ vstree_simplify_params simplifyParams(const RichParameterList& par)
 	}
 	p.sampling = par.getEnum("sampling") == 1 ? VSTREE_SAMPLING_FACE_CENTERS : VSTREE_SAMPLING_VERTICES;
 	p.error    = double(par.getFloat("error"));
+	if (par.getAbsPerc("distance") > 0) {
+		if (p.metric != VSTREE_METRIC_L2)
+			throw MLException("vstree: 'Max plane distance' applies to the L2 metric only; set it to 0 or choose L2");
+		p.error = l2Bound(par, diagonal);
+	}
 	p.d_a      = float(par.getFloat("d_a"));
 	p.d_d      = float(par.getFloat("d_d"));
 	p.max_depth = uint32_t(std::max(0, par.getInt("max_depth")));
 	return p;
 }
 
-void addTreeParams(RichParameterList& pl, double defError)
+void addTreeParams(RichParameterList& pl, double defError, double diagonal)
 {
 	pl.addParam(RichFloat("error", Scalarm(defError), "Error bound",
 		"Split threshold per cluster, read according to the metric. L2 (quadric): a relative "
 		"bound, the squared distance from a cluster's point to its samples' tangent planes over "
 		"the squared bounding-box diagonal (1e-3 = planes within about 3% of the diagonal; larger "
 		"= coarser). L2,1: unitless normal deviation, 1e-3 to 4. Density: a sample count >= 1."));
+	addDistanceParam(pl, diagonal);
 	pl.addParam(RichEnum("tree_kind", 0, kTreeKinds, "Tree",
 		"VS-Tree (octree far from the surface, quadtrees in local frames near it) or a plain Octree."));
 	pl.addParam(RichEnum("metric", 0, kMetrics, "Metric", "The error metric that decides whether a cell is split."));
@@ -265,15 +299,16 @@ int FilterVstreePlugin::postCondition(const QAction* a) const
 	}
 }
 
-RichParameterList FilterVstreePlugin::initParameterList(const QAction* a, const MeshModel&)
+RichParameterList FilterVstreePlugin::initParameterList(const QAction* a, const MeshModel& m)
 {
 	RichParameterList pl;
+	const double diagonal = double(m.cm.bbox.Diag());
 	switch (ID(a)) {
 	case FP_SIMPLIFY:
-		addTreeParams(pl, 1e-3);
+		addTreeParams(pl, 1e-3, diagonal);
 		break;
 	case FP_COLOUR:
-		addTreeParams(pl, 1e-3);
+		addTreeParams(pl, 1e-3, diagonal);
 		pl.addParam(RichEnum("label", 0, kLabelKinds, "Colour by",
 			"Cluster: one colour per cluster (leaf). T-node: one colour per T-node of the T-layer."));
 		break;
@@ -282,6 +317,7 @@ RichParameterList FilterVstreePlugin::initParameterList(const QAction* a, const 
 			"The tree's relative L2 bound: squared distance from a cluster's point to its samples' "
 			"tangent planes over the squared bounding-box diagonal. The de-noising control: larger = "
 			"smoother, fewer details."));
+		addDistanceParam(pl, diagonal);
 		pl.addParam(RichInt("levels", 6, "Refinement levels",
 			"Most refinement levels, each multiplying the triangle count by 4; in [0, 12]."));
 		pl.addParam(RichFloat("trim", 0, "Trim",
@@ -317,7 +353,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 	case FP_SIMPLIFY: {
 		MeshHandle in;
 		makeInput(a, passNormals, in);
-		const vstree_simplify_params p = simplifyParams(par);
+		const vstree_simplify_params p = simplifyParams(par, double(src->cm.bbox.Diag()));
 		vstree_simplify_result* res = nullptr;
 		check(vstree_simplify(in.p, &p, progressTrampoline, &prog, &res), "simplify");
 		struct Free { vstree_simplify_result* r; ~Free() { vstree_simplify_result_free(r); } } guard{res};
@@ -352,7 +388,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 		pts.tri.clear();
 		makeInput(pts, a.zeroNormals == 0, in);
 		vstree_reconstruct_params p = vstree_reconstruct_params_default();
-		p.error = double(par.getFloat("error"));
+		p.error = l2Bound(par, double(src->cm.bbox.Diag()));
 		const int levels = par.getInt("levels");
 		if (levels < 0)
 			throw MLException(QString("vstree: levels must be in [0, 12], got %1").arg(levels));
@@ -383,7 +419,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 	case FP_COLOUR: {
 		MeshHandle in;
 		makeInput(a, passNormals, in);
-		const vstree_simplify_params p = simplifyParams(par);
+		const vstree_simplify_params p = simplifyParams(par, double(src->cm.bbox.Diag()));
 		vstree_tree* tree = nullptr;
 		check(vstree_tree_build(in.p, &p, progressTrampoline, &prog, &tree), "tree_build");
 		struct Free { vstree_tree* t; ~Free() { vstree_tree_free(t); } } guard{tree};

@@ -102,6 +102,35 @@ def test_simplify_options():
         print(f"  {kw}: {out['output_vertices']} v / {out['output_triangles']} f")
 
 
+def percentage(value):
+    """A percentage of the bounding-box diagonal, in either pymeshlab's spelling."""
+    return (getattr(pymeshlab, "PercentageValue", None) or pymeshlab.Percentage)(value)
+
+
+def absolute(value):
+    return (getattr(pymeshlab, "PureValue", None) or pymeshlab.AbsoluteValue)(value)
+
+
+def test_distance_as_absolute_or_percentage():
+    ms = pymeshlab.MeshSet()
+    sphere(ms)
+    src_id = ms.current_mesh_id()
+    diagonal = ms.current_mesh().bounding_box().diagonal()
+    counts = {}
+    for name, kw in (("1%", dict(distance=percentage(1.0))), ("abs", dict(distance=absolute(0.01 * diagonal))),
+                     ("e", dict(error=1e-4)), ("3%", dict(distance=percentage(3.0)))):
+        ms.set_current_mesh(src_id)
+        counts[name] = ms.apply_filter(SIMPLIFY, **kw)["output_vertices"]
+    print(f"  distance: {counts}")
+    # 1% of the diagonal is the L2 bound (0.01)^2 = 1e-4, given either way (pymeshlab passes
+    # lengths as C++ floats, so the bound may differ from 1e-4 in its last digits).
+    assert counts["1%"] == counts["abs"]
+    assert abs(counts["1%"] - counts["e"]) <= max(2, 0.02 * counts["e"])
+    assert counts["3%"] < counts["1%"]
+    ms.set_current_mesh(src_id)
+    expect_error(ms, SIMPLIFY, "L2 metric only", distance=percentage(1.0), metric="Density (samples)", error=20)
+
+
 def test_simplify_point_cloud_with_normals():
     ms = pymeshlab.MeshSet()
     ms.add_mesh(sphere_points(3000, normals=True), "cloud")
