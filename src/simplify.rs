@@ -78,18 +78,51 @@ fn representative(tree: &VsTree, leaf: usize, origin: DVec3) -> (Vec3, Vec3) {
     (x.as_vec3(), stats.mean_normal().normalize_or_zero().as_vec3())
 }
 
-/// Simplifies `mesh` (or a point cloud with normals) by clustering in the tree `params`
-/// describe. Returns the simplified mesh and what was done.
-pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> Result<(Mesh, SimplifyStats)> {
-    let threads = Threads::new(params.threads)?;
+/// The samples, tree and clusters of a mesh (or a point cloud with normals): the steps
+/// [`simplify`] and the C API's tree handle share, with their times in seconds.
+pub struct Clustered {
+    pub samples: SampleSet,
+    pub tree: VsTree,
+    pub clusters: Clustering,
+    pub seconds_samples: f64,
+    pub seconds_tree: f64,
+    pub seconds_cluster: f64,
+}
+
+/// Takes the samples of `mesh` as `params` say (a cloud's points when it has no triangles),
+/// builds their tree (progress 0 to 0.8) and its clusters.
+pub fn cluster_mesh(
+    mesh: &Mesh,
+    params: &SimplifyParams,
+    threads: &Threads,
+    progress: &mut Progress,
+) -> Result<Clustered> {
     let t0 = Instant::now();
     let samples =
         if mesh.is_point_cloud() { SampleSet::from_cloud(mesh)? } else { SampleSet::from_mesh(mesh, params.sampling)? };
     let t1 = Instant::now();
-    let tree = tree::build(&samples, &params.tree, &threads, &mut progress.stage(0.0, 0.8))?;
+    let tree = tree::build(&samples, &params.tree, threads, &mut progress.stage(0.0, 0.8))?;
     let t2 = Instant::now();
     progress.report(0.8, "clustering")?;
-    let clusters = cluster(&tree, &threads);
+    let clusters = cluster(&tree, threads);
+    Ok(Clustered {
+        samples,
+        tree,
+        clusters,
+        seconds_samples: (t1 - t0).as_secs_f64(),
+        seconds_tree: (t2 - t1).as_secs_f64(),
+        seconds_cluster: t2.elapsed().as_secs_f64(),
+    })
+}
+
+/// Simplifies `mesh` (or a point cloud with normals) by clustering in the tree `params`
+/// describe. Returns the simplified mesh and what was done.
+pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> Result<(Mesh, SimplifyStats)> {
+    let threads = Threads::new(params.threads)?;
+    let Clustered { samples, tree, clusters, seconds_samples, seconds_tree, seconds_cluster } =
+        cluster_mesh(mesh, params, &threads, progress)?;
+    let t = Instant::now();
+    let stats = tree.stats();
     let out = if mesh.is_point_cloud() {
         Mesh::from_points(clusters.representatives, Some(clusters.normals))
     } else {
@@ -98,14 +131,14 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
     };
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
-        tree: tree.stats(),
+        tree: stats,
         input_vertices: mesh.positions.len(),
         input_triangles: mesh.triangles.len(),
         output_vertices: out.positions.len(),
         output_triangles: out.triangles.len(),
-        seconds_samples: (t1 - t0).as_secs_f64(),
-        seconds_tree: (t2 - t1).as_secs_f64(),
-        seconds_cluster: t2.elapsed().as_secs_f64(),
+        seconds_samples,
+        seconds_tree,
+        seconds_cluster: seconds_cluster + t.elapsed().as_secs_f64(),
     };
     Ok((out, stats))
 }

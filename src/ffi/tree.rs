@@ -10,8 +10,7 @@ use super::{guard, guard_or, non_null, vstree_status, write_out, Failure, FfiRes
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
 use crate::quadric::CellStats;
-use crate::samples::SampleSet;
-use crate::simplify::{cluster, vertex_labels, SimplifyParams, NO_CLUSTER};
+use crate::simplify::{cluster_mesh, vertex_labels, Clustered, SimplifyParams, NO_CLUSTER};
 use crate::tree::{self, Metric, NodeKind, VsTree};
 use rayon::prelude::*;
 use std::ffi::c_void;
@@ -212,14 +211,8 @@ pub unsafe extern "C" fn vstree_tree_build(
 /// The same steps as the library's simplification up to the clusters, keeping the tree.
 fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiResult<vstree_tree> {
     let threads = Threads::new(params.threads)?;
-    let t0 = Instant::now();
-    let samples =
-        if mesh.is_point_cloud() { SampleSet::from_cloud(mesh)? } else { SampleSet::from_mesh(mesh, params.sampling)? };
-    let t1 = Instant::now();
-    let tree = tree::build(&samples, &params.tree, &threads, &mut progress.stage(0.0, 0.8))?;
-    let t2 = Instant::now();
-    progress.report(0.8, "clustering")?;
-    let clusters = cluster(&tree, &threads);
+    let Clustered { samples, tree, clusters, seconds_samples, seconds_tree, .. } =
+        cluster_mesh(mesh, params, &threads, progress)?;
     let sampling = match mesh.is_point_cloud() {
         true => crate::MeshSampling::Vertices, // a cloud's samples are its points
         false => params.sampling,
@@ -330,8 +323,8 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
         max_cluster_error: max_error,
         mean_cluster_error: mean_error,
         diagonal: f64::from(tree.diagonal),
-        seconds_samples: (t1 - t0).as_secs_f64(),
-        seconds_tree: (t2 - t1).as_secs_f64(),
+        seconds_samples,
+        seconds_tree,
         seconds_total: 0.0,
     };
     Ok(vstree_tree { stats, nodes, t_nodes, levels, cluster_labels, t_node_labels })
