@@ -41,11 +41,12 @@ fn assert_closed_reconstruction(name: &str, cloud: &Mesh, genus: u32) {
     assert!(report.is_watertight(), "{name}: {report:?}");
     assert_eq!(report.genus(), Some(genus), "{name}: the result's genus");
     assert!(regular_share(&mesh) > 0.9, "{name}: {:.1}% valence 6", 100.0 * regular_share(&mesh));
-    assert!(stats.final_error < 5e-3, "{name}: RMS sample distance {:.2e} x diagonal", stats.final_error);
-    assert!(chamfer < 5e-3 * diagonal, "{name}: chamfer {:.2e} x diagonal", chamfer / diagonal);
-    // The worst points are where displacement folds a few triangles (measured up to 6.1e-2 on
-    // knot1); the bound keeps that from getting worse.
-    assert!(hausdorff < 8e-2 * diagonal, "{name}: hausdorff {:.2e} x diagonal", hausdorff / diagonal);
+    // Measured at most 2.4e-3 (kitten, whose scan is the noisiest) and 3.5e-3.
+    assert!(stats.final_error < 3e-3, "{name}: RMS sample distance {:.2e} x diagonal", stats.final_error);
+    assert!(chamfer < 4.5e-3 * diagonal, "{name}: chamfer {:.2e} x diagonal", chamfer / diagonal);
+    // The worst points are where displacement folds a few triangles (measured up to 2.7e-2 on
+    // the double torus); the bound keeps that from getting worse.
+    assert!(hausdorff < 4e-2 * diagonal, "{name}: hausdorff {:.2e} x diagonal", hausdorff / diagonal);
 }
 
 #[test]
@@ -67,7 +68,6 @@ fn real_shapes_of_known_genus() {
 }
 
 #[test]
-#[ignore = "known gap: fertility's base mesh gets extra handles where its thin parts nearly touch"]
 fn fertility_has_genus_four() {
     let Some(mesh) = common::load("fertility_20k.off") else { return };
     assert_closed_reconstruction("fertility", &shapes::sample_surface(&mesh, 100_000, 1), 4);
@@ -89,8 +89,8 @@ fn a_noisy_sphere_lands_on_the_true_sphere() {
     let max = off.iter().copied().fold(0.0, f32::max);
     eprintln!("noisy sphere: mean {mean:.4}, max {max:.4} from the true sphere");
     assert!(mean < 0.006, "mean distance to the true sphere {mean}");
-    // A few vertices fold out where displacement pulls them onto a noisy leaf (measured 0.052).
-    assert!(max < 0.07, "max distance to the true sphere {max}");
+    // A few vertices fold out where displacement pulls them onto a noisy leaf (measured 0.032).
+    assert!(max < 0.045, "max distance to the true sphere {max}");
 }
 
 #[test]

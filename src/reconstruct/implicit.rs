@@ -10,9 +10,9 @@
 //! the point counts as outside.
 //!
 //! Beyond a thin tip (an ear, a finger) the planes of its two sides blend to zero along the
-//! tip's mid-plane, which would grow a flap as far as the supports reach. So the caller adds
-//! the distance to the samples beyond a small tolerance (see `reconstruct`): far from every
-//! sample the function is pushed outside, and the flaps stop.
+//! tip's mid-plane, which would grow a flap as far as the supports reach; deep inside a thick
+//! part no support reaches. So away from the samples the caller lets the winding number
+//! decide the side (see `reconstruct` and `winding`).
 
 use crate::tree::{NodeKind, VsTree};
 use glam::Vec3;

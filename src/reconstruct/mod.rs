@@ -2,8 +2,9 @@
 //!
 //! 0. estimate normals where the cloud has none ([`crate::normals`]);
 //! 1. build the VS-Tree of the samples (the L2 bound is the de-noising control);
-//! 2. blend the T-nodes' planes into one implicit function ([`implicit`]), polygonise it on a
-//!    grid as fine as the deepest T-node ([`crate::polygonize`]), and cluster that mesh at the
+//! 2. blend the T-nodes' planes into one implicit function ([`implicit`]); farther than a grid
+//!    cell or two from every sample, the samples' winding number ([`winding`]) decides inside
+//!    or outside instead; polygonise that on a grid as fine as the deepest T-node ([`crate::polygonize`]), and cluster that mesh at the
 //!    T-layer into the base mesh M0, one vertex per T-node ([`base_mesh`]);
 //! 3. refine: split 1-to-4 on PN triangles and displace by the quadtrees ([`refine`]), until
 //!    the mesh is close enough to the samples or the quadtrees have no detail left;
@@ -16,6 +17,7 @@
 mod base_mesh;
 mod implicit;
 mod refine;
+mod winding;
 
 pub use refine::LevelStats;
 
@@ -34,15 +36,16 @@ use std::time::Instant;
 
 /// At most this many samples are measured for error(M, S).
 pub const ERROR_SAMPLES: usize = 100_000;
-/// T-node supports: balls of this many times the cube's half diagonal (MPU's α = 0.75 of the
-/// full diagonal).
-const SUPPORT_SCALE: f32 = 1.5;
-/// Beyond this many grid cells from every sample, the implicit function is pushed outside.
-const FAR_FROM_SAMPLES: f32 = 2.0;
-/// Beyond this many grid cells from every sample, a point is outside. Behind an open scan
-/// the planes would otherwise say "inside" as far as their supports reach; this closes such
-/// a surface into a thin slab (which trimming opens again). Inside a closed solid it only
-/// makes an inner shell that no sample's cell touches, so the tracker never finds it.
+/// T-node supports: balls of this many times the cube's half diagonal. MPU's α = 0.75 of the
+/// full diagonal would be 1.5; wider supports average out the planes of small, noisy T-nodes,
+/// which fertility needs to keep its genus at every bound from 1e-4 to 1e-7.
+const SUPPORT_SCALE: f32 = 2.0;
+/// Beyond this many grid cells from every sample, the implicit function is pushed away from
+/// zero, outward or inward as the winding number says.
+const FAR_FROM_SAMPLES: f32 = 1.5;
+/// Beyond this many grid cells from every sample, the winding number alone decides inside or
+/// outside. Behind an open scan the winding number falls below one half towards the scan's
+/// border, which closes the surface into a thin shell (which trimming opens again).
 const OUTSIDE_BEYOND: f32 = 4.0;
 /// The polygonisation gives up beyond this many grid cells along the surface.
 const MAX_GRID_CELLS: usize = 50_000_000;
@@ -194,12 +197,27 @@ pub fn reconstruct(
     // distance to the samples must leave room for the typical T-node too.
     let typical_t_half = median(tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| n.half).collect());
     let tolerance = FAR_FROM_SAMPLES * unit;
+    let winding = winding::WindingNumber::new(&tree);
     let f = |p: Vec3| {
         let d = near.distance(p);
-        if d > OUTSIDE_BEYOND * unit.max(typical_t_half) {
-            f32::MAX
+        if d <= tolerance {
+            return blend.eval(p);
+        }
+        // Far from the samples the planes are extrapolations: the winding number says which
+        // side p is on, and the function moves away from zero on that side.
+        let side = if winding.inside(p) { -1.0 } else { 1.0 };
+        let blended = blend.eval(p);
+        if d > OUTSIDE_BEYOND * unit.max(typical_t_half) || blended == f32::MAX {
+            side * f32::MAX
         } else {
-            blend.eval(p) + (d - tolerance).max(0.0)
+            // The winding number's side wins; the planes may only push further that way.
+            // Otherwise planes that run on past a thin part bulge into the outside, and a
+            // bulge that meets another part adds a handle.
+            if side > 0.0 {
+                blended.max(0.0) + (d - tolerance)
+            } else {
+                blended.min(0.0) - (d - tolerance)
+            }
         }
     };
     let fine = track_surface(&f, &grid, &seeds, MAX_GRID_CELLS, &threads)?;
@@ -223,10 +241,11 @@ pub fn reconstruct(
     };
     let t2 = Instant::now();
 
+    let refiner = refine::Refiner::new(&tree, &threads);
+    refiner.snap_base(&mut surface);
     let measured = evenly_spread(&samples.positions, ERROR_SAMPLES);
     let (mut rms, mut max) = sample_error(&surface, &measured, tree.diagonal, &threads);
     stats.base_error = rms;
-    let refiner = refine::Refiner::new(&tree, &threads);
     for level in 0..params.max_levels {
         if rms <= params.target_distance || 4 * surface.triangles.len() > params.max_triangles {
             break;

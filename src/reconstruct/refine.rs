@@ -154,6 +154,39 @@ impl<'t> Refiner<'t> {
         (out, LevelStats { new_vertices: placed.len(), displaced: moves.len() })
     }
 
+    /// Moves each vertex of the base mesh along the normal onto the tangent plane of the
+    /// quadtree leaf under it (its samples' centroid and mean normal). M0 lies on the blended
+    /// T-node planes, which pass through their patches' centroids, so on a curved surface it
+    /// sits inside by a T-node patch's sag; a leaf is smaller, and so is its sag. Moves longer
+    /// than the T-node's half size are not made (the leaf would belong to another sheet).
+    pub fn snap_base(&self, s: &mut Surface) {
+        for v in 0..s.positions.len() {
+            let t = s.labels[v] as usize;
+            let Some(leaf) = self.leaf_under(t, self.uv(t, s.positions[v])) else { continue };
+            let n = self.normal[leaf];
+            let height = (self.average[leaf] - s.positions[v]).dot(n);
+            if n != Vec3::ZERO && height.abs() <= self.tree.nodes[t].half {
+                s.positions[v] += n * height;
+                s.normals[v] = n;
+            }
+        }
+    }
+
+    /// The leaf of T-node `t`'s quadtree whose square holds plane coordinates `uv`, if any.
+    fn leaf_under(&self, t: usize, uv: Vec2) -> Option<usize> {
+        let mut i = t;
+        while !self.tree.nodes[i].is_leaf() {
+            let center = if i == t {
+                self.tree.frames[self.tree.nodes[t].frame as usize].square_center
+            } else {
+                self.tree.nodes[i].center_uv()
+            };
+            let slot = (uv.x >= center.x) as u8 | ((uv.y >= center.y) as u8) << 1;
+            i = self.tree.nodes[i].children().find(|&c| self.tree.nodes[c].slot == slot)?;
+        }
+        (self.tree.nodes[i].count > 0).then_some(i)
+    }
+
     /// Coordinates of `p` in the plane of T-node `t`.
     fn uv(&self, t: usize, p: Vec3) -> Vec2 {
         self.tree.frames[self.tree.nodes[t].frame as usize].project(p)
