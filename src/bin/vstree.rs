@@ -97,6 +97,9 @@ enum Command {
     },
 }
 
+/// The L2 bound to simplify with, and for `stats`, when `--error` is not given.
+const SIMPLIFY_ERROR: f64 = 2e-3;
+
 #[derive(Args, Clone)]
 struct TreeArgs {
     /// Hierarchy: the VS-Tree, or a plain octree (the baseline).
@@ -108,9 +111,10 @@ struct TreeArgs {
     /// Error bound per cluster. L2: sum of squared sample-plane distances over the squared
     /// bounding-box diagonal (every sample then lies within sqrt(error) x diagonal of its
     /// cluster's point); l21: mean squared normal deviation (0-4); density: samples per cluster.
-    /// Larger = coarser output.
-    #[arg(long, default_value_t = 2e-3, allow_negative_numbers = true)]
-    error: f64,
+    /// Larger = coarser output (and, to reconstruct, smoother: it is the de-noising control).
+    /// [default: 2e-3 to simplify and for stats, 1e-5 to reconstruct]
+    #[arg(long, allow_negative_numbers = true)]
+    error: Option<f64>,
     /// Normal-cone threshold of the height-field test, in [0, 1]: a cell becomes a surface
     /// (2D) node only if every normal's dot product with the mean normal exceeds it. Raise it
     /// for more adaptivity in curved areas.
@@ -153,7 +157,7 @@ enum Sampling {
 }
 
 impl TreeArgs {
-    fn params(&self) -> TreeParams {
+    fn params(&self, default_error: f64) -> TreeParams {
         TreeParams {
             kind: match self.tree {
                 Kind::Vstree => TreeKind::VsTree,
@@ -164,7 +168,7 @@ impl TreeArgs {
                 MetricArg::L21 => Metric::L21,
                 MetricArg::Density => Metric::Density,
             },
-            error: self.error,
+            error: self.error.unwrap_or(default_error),
             d_a: self.da,
             d_d: self.dd,
             max_depth: self.max_depth,
@@ -187,10 +191,11 @@ fn main() -> ExitCode {
 fn run(command: Command) -> vstree::Result<()> {
     match command {
         Command::Simplify { input, output, tree, sampling, ascii } => {
-            tree.params().check()?; // before reading what may be a large file
+            let tree_params = tree.params(SIMPLIFY_ERROR);
+            tree_params.check()?; // before reading what may be a large file
             let (mesh, read_s) = timed(|| io::read(&input))?;
             let params = SimplifyParams {
-                tree: tree.params(),
+                tree: tree_params,
                 sampling: match sampling {
                     Sampling::Vertices => MeshSampling::Vertices,
                     Sampling::Faces => MeshSampling::FaceCenters,
@@ -208,7 +213,7 @@ fn run(command: Command) -> vstree::Result<()> {
             let normals = vstree::normals::NormalParams { neighbours, reorient_given: reorient, ..Default::default() };
             let params = ReconstructParams {
                 normals,
-                tree: tree.params(),
+                tree: tree.params(ReconstructParams::default().tree.error),
                 target_distance: target,
                 max_levels: levels,
                 trim,
@@ -227,7 +232,8 @@ fn run(command: Command) -> vstree::Result<()> {
         }
         Command::Demo { out } => demo(&out),
         Command::Stats { input, tree, compare } => {
-            tree.params().check()?;
+            let tree_params = tree.params(SIMPLIFY_ERROR);
+            tree_params.check()?;
             let mesh = io::read(&input)?;
             let samples = if mesh.is_point_cloud() {
                 SampleSet::from_cloud(&mesh)?
@@ -235,7 +241,7 @@ fn run(command: Command) -> vstree::Result<()> {
                 SampleSet::from_mesh(&mesh, MeshSampling::Vertices)?
             };
             let threads = Threads::new(tree.threads)?;
-            let mut kinds = vec![tree.params()];
+            let mut kinds = vec![tree_params];
             if compare {
                 let other = if kinds[0].kind == TreeKind::VsTree { TreeKind::Octree } else { TreeKind::VsTree };
                 kinds.push(TreeParams { kind: other, ..kinds[0] });
