@@ -243,6 +243,7 @@ pub fn reconstruct(
 
     let refiner = refine::Refiner::new(&tree, &threads);
     refiner.snap_base(&mut surface);
+    refiner.unfold_base(&mut surface);
     let measured = evenly_spread(&samples.positions, ERROR_SAMPLES);
     let (mut rms, mut max) = sample_error(&surface, &measured, tree.diagonal, &threads);
     stats.base_error = rms;

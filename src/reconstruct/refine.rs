@@ -143,14 +143,16 @@ impl<'t> Refiner<'t> {
             .collect();
         let mut displaced = vec![false; out.positions.len()];
         for &(v, leaf) in &moves {
-            out.positions[v as usize] = self.average[leaf as usize];
+            let v = v as usize;
+            out.positions[v] = self.place_on_leaf(leaf as usize, out.positions[v]);
             if self.normal[leaf as usize] != Vec3::ZERO {
-                out.normals[v as usize] = self.normal[leaf as usize];
+                out.normals[v] = self.normal[leaf as usize];
             }
-            displaced[v as usize] = true;
+            displaced[v] = true;
         }
 
         smooth_tangentially(&mut out, old, &displaced);
+        self.unfold(&mut out, old as usize);
         (out, LevelStats { new_vertices: placed.len(), displaced: moves.len() })
     }
 
@@ -163,13 +165,70 @@ impl<'t> Refiner<'t> {
         for v in 0..s.positions.len() {
             let t = s.labels[v] as usize;
             let Some(leaf) = self.leaf_under(t, self.uv(t, s.positions[v])) else { continue };
-            let n = self.normal[leaf];
-            let height = (self.average[leaf] - s.positions[v]).dot(n);
-            if n != Vec3::ZERO && height.abs() <= self.tree.nodes[t].half {
-                s.positions[v] += n * height;
-                s.normals[v] = n;
+            let snapped = self.onto_leaf(leaf, s.positions[v]);
+            if self.normal[leaf] != Vec3::ZERO && snapped.distance(s.positions[v]) <= self.tree.nodes[t].half {
+                s.positions[v] = snapped;
+                s.normals[v] = self.normal[leaf];
             }
         }
+    }
+
+    /// Unfolds the base mesh where clustering left triangles facing against their corners'
+    /// normals (where a T-node is large for the curvature under it): each corner of such a
+    /// triangle moves to the mean of its neighbours, then onto the quadtree leaf under that
+    /// point. A few rounds; corners that cannot be unfolded stay where they are.
+    pub fn unfold_base(&self, s: &mut Surface) {
+        self.unfold(s, 0);
+    }
+
+    /// [`Refiner::unfold_base`] for the vertices from `first` on (the others stay put).
+    fn unfold(&self, s: &mut Surface, first: usize) {
+        let neighbours = vertex_neighbours(&s.triangles, s.positions.len());
+        for _ in 0..UNFOLD_ROUNDS {
+            let folded = folded_vertices(s);
+            if folded.is_empty() {
+                return;
+            }
+            for v in folded.into_iter().filter(|&v| v >= first) {
+                let ring = &neighbours[v];
+                if ring.is_empty() {
+                    continue;
+                }
+                let mean = ring.iter().map(|&w| s.positions[w as usize]).sum::<Vec3>() / ring.len() as f32;
+                // Back onto the surface: the leaf under the mean, in whichever T-node holds it.
+                let t = t_node_at(self.tree, mean).map_or(s.labels[v] as usize, |t| t as usize);
+                if let Some(leaf) = self.leaf_under(t, self.uv(t, mean)).filter(|&l| self.normal[l] != Vec3::ZERO) {
+                    s.positions[v] = self.place_on_leaf(leaf, mean);
+                }
+            }
+        }
+    }
+
+    /// `p` moved onto leaf `leaf`: sideways just enough to be over the leaf's square, then
+    /// along the leaf's normal onto its tangent plane. The leaf chosen for a vertex can be
+    /// anywhere in the vertex's S-node; jumping to its average sample slides the vertex over
+    /// its neighbours (folds), and extending the leaf's plane far beyond the leaf misses the
+    /// surface by the curvature.
+    fn place_on_leaf(&self, leaf: usize, p: Vec3) -> Vec3 {
+        let node = &self.tree.nodes[leaf];
+        let frame = &self.tree.frames[node.frame as usize];
+        let (center, half) = if node.kind == NodeKind::Surface {
+            (node.center_uv(), node.half)
+        } else {
+            (frame.square_center, frame.square_half)
+        };
+        let uv = frame.project(p);
+        let shift = (uv - center).clamp(Vec2::splat(-half), Vec2::splat(half)) + center - uv;
+        self.onto_leaf(leaf, p + frame.u * shift.x + frame.v * shift.y)
+    }
+
+    /// `p` moved along leaf `leaf`'s mean normal onto its tangent plane (through the average
+    /// sample). Moving straight to the average sample would also slide the vertex sideways
+    /// by up to the leaf's size, over its neighbours, and fold triangles; along the normal it
+    /// keeps the place the 1-to-4 split gave it on the surface.
+    fn onto_leaf(&self, leaf: usize, p: Vec3) -> Vec3 {
+        let n = self.normal[leaf];
+        p + n * (self.average[leaf] - p).dot(n)
     }
 
     /// The leaf of T-node `t`'s quadtree whose square holds plane coordinates `uv`, if any.
@@ -261,6 +320,42 @@ impl<'t> Refiner<'t> {
             self.tree.frames[node.frame as usize].square_center
         }
     }
+}
+
+/// Rounds of [`Refiner::unfold_base`].
+const UNFOLD_ROUNDS: usize = 5;
+
+/// Each vertex's neighbours along edges, sorted and unique.
+fn vertex_neighbours(triangles: &[[u32; 3]], vertices: usize) -> Vec<Vec<u32>> {
+    let mut neighbours = vec![Vec::new(); vertices];
+    for t in triangles {
+        for k in 0..3 {
+            neighbours[t[k] as usize].push(t[(k + 1) % 3]);
+            neighbours[t[(k + 1) % 3] as usize].push(t[k]);
+        }
+    }
+    for ring in &mut neighbours {
+        ring.sort_unstable();
+        ring.dedup();
+    }
+    neighbours
+}
+
+/// The corners of triangles whose normal points against the sum of their corners' normals.
+fn folded_vertices(s: &Surface) -> Vec<usize> {
+    let mut folded: Vec<usize> = s
+        .triangles
+        .iter()
+        .filter(|t| {
+            let [a, b, c] = t.map(|v| s.positions[v as usize]);
+            let corners: Vec3 = t.iter().map(|&v| s.normals[v as usize]).sum();
+            (b - a).cross(c - a).dot(corners) < 0.0
+        })
+        .flat_map(|t| t.map(|v| v as usize))
+        .collect();
+    folded.sort_unstable();
+    folded.dedup();
+    folded
 }
 
 /// The midpoint of a PN triangle's edge curve from (`pa`, `na`) to (`pb`, `nb`), and the PN
