@@ -59,9 +59,16 @@ fn vertex_neighbours(mesh: &Mesh) -> Vec<Vec<u32>> {
 /// cannot be represented at the T-layer (it is a bubble of the implicit function).
 const MIN_T_NODES_PER_COMPONENT: usize = 4;
 
+/// See [`stray_components`].
+const MIN_NEAR_SHARE: f64 = 0.25;
+
 /// Marks the vertices of components that span fewer than [`MIN_T_NODES_PER_COMPONENT`]
-/// T-nodes.
-fn small_components(mesh: &Mesh, labels: &[u32]) -> Vec<bool> {
+/// T-nodes, or with fewer than [`MIN_NEAR_SHARE`] of their vertices `near_samples`: a shell
+/// that the winding number put away from the samples, such as a bubble inside the tube of a
+/// sparsely sampled torus, where the few samples' areas are rough. A real surface runs through
+/// its samples: a closed scan almost everywhere, and even the closed blob around a single
+/// open range scan on its front side, about half of it.
+fn stray_components(mesh: &Mesh, labels: &[u32], near_samples: &[bool]) -> Vec<bool> {
     let neighbours = vertex_neighbours(mesh);
     let mut component = vec![u32::MAX; mesh.positions.len()];
     let mut dropped = vec![false; mesh.positions.len()];
@@ -84,7 +91,8 @@ fn small_components(mesh: &Mesh, labels: &[u32]) -> Vec<bool> {
         let mut t_nodes: Vec<u32> = members.iter().map(|&v| labels[v as usize]).collect();
         t_nodes.sort_unstable();
         t_nodes.dedup();
-        if t_nodes.len() < MIN_T_NODES_PER_COMPONENT {
+        let near = members.iter().filter(|&&v| near_samples[v as usize]).count();
+        if t_nodes.len() < MIN_T_NODES_PER_COMPONENT || (near as f64) < MIN_NEAR_SHARE * members.len() as f64 {
             for &v in &members {
                 dropped[v as usize] = true;
             }
@@ -100,11 +108,11 @@ pub(crate) struct BaseMesh {
 }
 
 /// Collapses every edge whose ends share a label, while the link condition allows, and places
-/// each remaining vertex at the mean of the fine vertices it absorbed. Components with no
-/// labelled vertex (bubbles of the implicit function away from every T-node) are dropped.
-pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32]) -> BaseMesh {
+/// each remaining vertex at the mean of the fine vertices it absorbed. Stray components
+/// (bubbles of the implicit function, see [`stray_components`]) are dropped.
+pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], near_samples: &[bool]) -> BaseMesh {
     let mut c = Collapser::new(fine);
-    let dropped = small_components(fine, labels);
+    let dropped = stray_components(fine, labels, near_samples);
     for (t, tri) in fine.triangles.iter().enumerate() {
         if tri.iter().any(|&v| labels[v as usize] == UNLABELLED || dropped[v as usize]) {
             c.alive_face[t] = false;
@@ -257,7 +265,7 @@ mod tests {
             (crate::shapes::double_torus(), 2),
         ] {
             // Eight clusters, the octants: collapse as far as topology allows.
-            let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh));
+            let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), &vec![true; mesh.positions.len()]);
             let r = analyze(&base.mesh);
             assert!(r.is_watertight(), "{r:?}");
             assert_eq!(r.genus(), Some(genus));
@@ -268,7 +276,7 @@ mod tests {
     #[test]
     fn components_spanning_fewer_than_four_t_nodes_are_dropped() {
         let mesh = crate::shapes::icosphere(1.0, 2);
-        let base = cluster_at_t_layer(&mesh, &vec![0; mesh.positions.len()]);
+        let base = cluster_at_t_layer(&mesh, &vec![0; mesh.positions.len()], &vec![true; mesh.positions.len()]);
         assert!(base.mesh.positions.is_empty() && base.mesh.triangles.is_empty());
     }
 
@@ -276,7 +284,7 @@ mod tests {
     fn labels_partition_a_sphere_into_clusters() {
         let mesh = crate::shapes::icosphere(1.0, 4);
         // Eight clusters: the octants.
-        let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh));
+        let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), &vec![true; mesh.positions.len()]);
         let r = analyze(&base.mesh);
         assert!(r.is_watertight() && r.genus() == Some(0));
         assert_eq!(base.mesh.positions.len(), 8, "one vertex per octant");

@@ -229,7 +229,9 @@ pub fn reconstruct(
     stats.fine_triangles = fine.triangles.len();
     progress.report(0.4, "base mesh")?;
     let labels = base_mesh::label_vertices(&tree, &fine);
-    let base = base_mesh::cluster_at_t_layer(&fine, &labels);
+    let near_samples: Vec<bool> =
+        threads.run(|| fine.positions.par_iter().map(|&p| near.distance(p) <= tolerance).collect());
+    let base = base_mesh::cluster_at_t_layer(&fine, &labels, &near_samples);
     stats.base_vertices = base.mesh.positions.len();
     stats.base_triangles = base.mesh.triangles.len();
     stats.base_genus = topology::analyze(&base.mesh).genus();
