@@ -8,7 +8,7 @@
 //! them are then built independently in parallel and appended in a fixed order. Nothing
 //! depends on the number of threads, so the tree is identical for 1 or N threads.
 
-use super::indicator::{frame, is_height_field};
+use super::indicator::{frame, is_height_field, reach};
 use super::partition::partition;
 use super::{representative, Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
 use crate::error::{Error, Result};
@@ -223,8 +223,9 @@ impl Builder {
             NodeKind::Volume => {
                 let slice = part.slice(&node);
                 let centroid = (stats.centroid() + self.origin).as_vec3();
+                let reach = reach(centroid, node.center, node.half);
                 let flat = self.params.kind == TreeKind::VsTree
-                    && is_height_field(slice, centroid, stats.mean_normal(), self.params.d_a, self.params.d_d);
+                    && is_height_field(slice, centroid, stats.mean_normal(), reach, self.params.d_a, self.params.d_d);
                 if flat {
                     let f = frame(slice, stats, self.origin);
                     let index = (part.shared_frames.len() + part.frames.len()) as u32;

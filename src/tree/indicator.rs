@@ -9,23 +9,43 @@ use glam::{DVec3, Vec2, Vec3};
 /// centroid `c` with normal n̄ (the normalised average normal):
 /// every nⱼ·n̄ > d_a (normal cone), and max |(pⱼ − c)·n̄| < d_d · max ‖pₖ − c‖ (displacement).
 /// Samples with a zero normal carry no orientation and are left out of the cone test.
-pub(super) fn is_height_field(samples: &[TreeSample], centroid: Vec3, mean_normal: DVec3, d_a: f32, d_d: f32) -> bool {
+///
+/// `reach` bounds every ‖pₖ − c‖ from above (the distance from c to the cell's farthest corner,
+/// with a margin for rounding), so a single height beyond d_d · reach decides the test: the pass
+/// stops at the first sample that fails either condition, and the result is the same as the
+/// full test's.
+pub(super) fn is_height_field(
+    samples: &[TreeSample],
+    centroid: Vec3,
+    mean_normal: DVec3,
+    reach: f32,
+    d_a: f32,
+    d_d: f32,
+) -> bool {
     if mean_normal.length() < 1e-6 {
         return false; // normals cancel out: no plane to project on
     }
     let n = mean_normal.normalize().as_vec3();
+    let too_high = d_d * reach;
     let mut max_height = 0.0f32;
     let mut max_radius_sq = 0.0f32;
     for s in samples {
-        if s.normal != Vec3::ZERO && s.normal.dot(n) <= d_a {
+        let d = s.position - centroid;
+        let h = d.dot(n).abs();
+        if h > too_high || (s.normal.dot(n) <= d_a && s.normal != Vec3::ZERO) {
             return false;
         }
-        let d = s.position - centroid;
-        max_height = max_height.max(d.dot(n).abs());
+        max_height = max_height.max(h);
         max_radius_sq = max_radius_sq.max(d.length_squared());
     }
     // All samples at one point: trivially flat.
     max_radius_sq == 0.0 || max_height < d_d * max_radius_sq.sqrt()
+}
+
+/// An upper bound of the distance from `p` (inside the cube `center ± half`) to any point of
+/// the cube: the distance to its farthest corner, enlarged for rounding.
+pub(super) fn reach(p: Vec3, center: Vec3, half: f32) -> f32 {
+    ((p - center).abs() + half).length() * (1.0 + 1e-3)
 }
 
 /// The T-node frame: n = the average normal; u, v = the normalised projections onto the plane
@@ -87,11 +107,11 @@ mod tests {
     fn flat_patch_is_a_height_field_and_a_fold_is_not() {
         let flat: Vec<_> = (0..25).map(|i| sample(Vec3::new((i % 5) as f32, (i / 5) as f32, 0.0), Vec3::Z)).collect();
         let st = stats_of(&flat);
-        assert!(is_height_field(&flat, st.centroid().as_vec3(), st.mean_normal(), 0.0, 1.0 / 6.0));
+        assert!(is_height_field(&flat, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0 / 6.0));
         let mut folded = flat.clone();
         folded.push(sample(Vec3::new(2.0, 2.0, 0.1), -Vec3::Z));
         let st = stats_of(&folded);
-        assert!(!is_height_field(&folded, st.centroid().as_vec3(), st.mean_normal(), 0.0, 1.0 / 6.0));
+        assert!(!is_height_field(&folded, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0 / 6.0));
     }
 
     #[test]
@@ -99,8 +119,30 @@ mod tests {
         let mut s: Vec<_> = (0..25).map(|i| sample(Vec3::new((i % 5) as f32, (i / 5) as f32, 0.0), Vec3::Z)).collect();
         s.push(sample(Vec3::new(2.0, 2.0, 1.5), Vec3::Z));
         let st = stats_of(&s);
-        assert!(!is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), 0.0, 1.0 / 6.0));
-        assert!(is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), 0.0, 1.0));
+        assert!(!is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0 / 6.0));
+        assert!(is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0));
+    }
+
+    #[test]
+    fn stopping_early_on_a_tall_sample_gives_the_full_test_s_answer() {
+        // Bumps of growing height on a patch filling the cube [0, 4]³: the bound from the cube's
+        // corners only shortens the pass, never changes the answer.
+        for bump in 0..40 {
+            let s: Vec<_> = (0..25)
+                .map(|i| {
+                    let (x, y) = ((i % 5) as f32, (i / 5) as f32);
+                    let z = 2.0 + 0.05 * bump as f32 * ((x - 2.0).powi(2) + (y - 2.0).powi(2)) / 8.0;
+                    sample(Vec3::new(x, y, z), Vec3::new(2.0 - x, 2.0 - y, 20.0))
+                })
+                .collect();
+            let st = stats_of(&s);
+            let c = st.centroid().as_vec3();
+            let r = reach(c, Vec3::splat(2.0), 2.0);
+            for d_d in [0.0, 0.05, 1.0 / 6.0, 0.3, 1.0] {
+                let full = is_height_field(&s, c, st.mean_normal(), f32::INFINITY, 0.0, d_d);
+                assert_eq!(is_height_field(&s, c, st.mean_normal(), r, 0.0, d_d), full, "bump {bump}, d_d {d_d}");
+            }
+        }
     }
 
     #[test]
