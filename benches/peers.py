@@ -19,95 +19,18 @@ The Rust bench reads the outputs back and measures their distance to the input w
 
 PyMeshLab runs from a virtual environment under `target/bench-venv`, created on first use with
 a pinned version; missing system libraries (libGL and friends) are installed with apt-get when
-possible. Set `PEERS_NO_SETUP=1` to skip the set-up and use whatever `python3` has.
+possible (see `benches/bench_venv.py`). Set `PEERS_NO_SETUP=1` to skip the set-up and use
+whatever `python3` has.
 """
 
 import argparse
-import os
-import re
-import shutil
 import statistics
-import subprocess
-import sys
 import time
 from pathlib import Path
 
+from bench_venv import ROOT, ensure, log
+
 PYMESHLAB = "pymeshlab==2025.7.post1"
-ROOT = Path(__file__).resolve().parent.parent
-VENV = ROOT / "target" / "bench-venv"
-# Shared libraries that the PyMeshLab wheel expects from the system, and their Debian packages.
-SYSTEM_LIBS = {
-    "libGL.so.1": "libgl1",
-    "libGLX.so.0": "libglx0",
-    "libOpenGL.so.0": "libopengl0",
-    "libGLU.so.1": "libglu1-mesa",
-    "libX11.so.6": "libx11-6",
-    "libxcb.so.1": "libxcb1",
-    "libgomp.so.1": "libgomp1",
-}
-
-
-def log(message):
-    print(f"peers.py: {message}", file=sys.stderr, flush=True)
-
-
-def venv_python():
-    return VENV / "bin" / "python"
-
-
-def in_venv():
-    return Path(sys.prefix).resolve() == VENV.resolve()
-
-
-def try_import(python):
-    """Runs `import pymeshlab` in `python`; returns None on success, else the error text."""
-    probe = subprocess.run(
-        [str(python), "-c", "import pymeshlab"], capture_output=True, text=True
-    )
-    return None if probe.returncode == 0 else (probe.stderr.strip() or "import failed")
-
-
-def apt_install(packages):
-    """Installs Debian packages, as root or through sudo; returns whether it worked."""
-    if shutil.which("apt-get") is None:
-        return False
-    prefix = [] if os.geteuid() == 0 else (["sudo", "-n"] if shutil.which("sudo") else None)
-    if prefix is None:
-        return False
-    log(f"installing system packages: {' '.join(packages)}")
-    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
-    for command in (["apt-get", "update", "-q"], ["apt-get", "install", "-y", "-q", *packages]):
-        if subprocess.run(prefix + command, env=env, stdout=sys.stderr).returncode != 0:
-            return False
-    return True
-
-
-def setup():
-    """Makes sure the venv exists with PyMeshLab importable, then re-runs this script in it."""
-    python = venv_python()
-    if not python.exists():
-        log(f"creating {VENV}")
-        subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
-    error = try_import(python)
-    if error is not None and "No module named" in error:
-        log(f"installing {PYMESHLAB} into {VENV}")
-        subprocess.run(
-            [str(python), "-m", "pip", "install", "-q", PYMESHLAB],
-            check=True,
-            stdout=sys.stderr,
-        )
-        error = try_import(python)
-    for _ in range(len(SYSTEM_LIBS)):
-        if error is None:
-            break
-        missing = re.findall(r"(lib[\w+.-]+\.so[.\d]*): cannot open shared object", error)
-        packages = sorted({SYSTEM_LIBS[m] for m in missing if m in SYSTEM_LIBS})
-        if not packages or not apt_install(packages):
-            break
-        error = try_import(python)
-    if error is not None:
-        sys.exit(f"peers.py: cannot import pymeshlab in {VENV}:\n{error}")
-    os.execv(str(python), [str(python), str(Path(__file__).resolve()), *sys.argv[1:]])
 
 
 def decimate(base, filter_name, **params):
@@ -171,8 +94,7 @@ def main():
     parser.add_argument("--name", default=None)
     args = parser.parse_args()
 
-    if not in_venv() and os.environ.get("PEERS_NO_SETUP") != "1":
-        setup()  # does not return
+    ensure(required=[("pymeshlab", PYMESHLAB)])  # re-runs this script in the venv
 
     import pymeshlab
 

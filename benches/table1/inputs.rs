@@ -1,9 +1,9 @@
 //! The benchmark's inputs: every mesh with triangles in the data directory (sampled at its
 //! vertices), and dense clouds drawn on a mesh surface.
 
-use glam::Vec3;
+use crate::common::inputs::surface_cloud;
 use std::path::{Path, PathBuf};
-use vstree::{io, shapes, Mesh, MeshSampling, SampleSet};
+use vstree::{io, Mesh, MeshSampling, SampleSet};
 
 /// One input of the table.
 pub struct Input {
@@ -67,38 +67,10 @@ fn model(path: &Path) -> Option<Input> {
     Some(Input { name: stem(path), path: Some(path.to_path_buf()), mesh: Some(mesh), samples })
 }
 
-/// The surface dense clouds are drawn on: igea (a model of the paper) with smooth vertex
-/// normals, or a bumpy sphere when the data directory is absent. Returns its name too.
-pub fn cloud_surface(data: &Path) -> (String, Mesh) {
-    let igea = data.join("igea.ply");
-    if let Ok(mut mesh) = io::read(&igea) {
-        if let Ok(samples) = SampleSet::from_mesh(&mesh, MeshSampling::Vertices) {
-            // Area-weighted vertex normals, so sampled normals vary smoothly like a scan's.
-            let mut normals = vec![Vec3::ZERO; mesh.positions.len()];
-            for (&v, &n) in samples.origin.iter().zip(&samples.normals) {
-                normals[v as usize] = n;
-            }
-            mesh.normals = Some(normals);
-            return ("igea".into(), mesh);
-        }
-    }
-    ("bumpy sphere".into(), shapes::bumpy_sphere(1.0, 0.2, 6.0, 7))
-}
-
 /// `count` samples drawn uniformly by area on `surface` (fixed seed), with their normals.
 pub fn cloud(surface: &Mesh, count: usize) -> SampleSet {
-    let cloud = shapes::sample_surface(surface, count, 2006);
+    let cloud = surface_cloud(surface, count);
     // `sample_surface` already gives unit normals: move them instead of copying.
     let normals = cloud.normals.unwrap_or_default();
     SampleSet { origin: (0..cloud.positions.len() as u32).collect(), positions: cloud.positions, normals }
-}
-
-/// `1000000` as `1M`, `1500` as `1.5k`.
-pub fn short_count(n: usize) -> String {
-    match n {
-        n if n >= 1_000_000 && n % 1_000_000 == 0 => format!("{}M", n / 1_000_000),
-        n if n >= 1_000_000 => format!("{:.1}M", n as f64 / 1e6),
-        n if n >= 1_000 && n % 1_000 == 0 => format!("{}k", n / 1_000),
-        n => n.to_string(),
-    }
 }

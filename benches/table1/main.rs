@@ -11,14 +11,18 @@
 //!     [--peer-runs N] [--no-memory] [--no-write]
 //! ```
 
+#[path = "../common/mod.rs"]
+mod common;
 mod inputs;
 mod measure;
 mod memory;
 mod peers;
 mod report;
 
+use common::cli::{list, names, number, shown};
+use common::distance::Distances;
 use inputs::Input;
-use measure::{Distances, KINDS};
+use measure::KINDS;
 use report::{Context, Method, Report, Row};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -84,7 +88,7 @@ impl Options {
                     o.big = if v == "none" { Vec::new() } else { list(v)? };
                 }
                 "--bounds" => o.bounds = list(value()?)?,
-                "--models" => o.models = Some(v_split(value()?)),
+                "--models" => o.models = Some(names(value()?)),
                 "--data" => o.data = PathBuf::from(value()?),
                 other => return Err(format!("unknown option {other}\n{USAGE}")),
             }
@@ -96,23 +100,10 @@ impl Options {
     }
 }
 
-fn number<T: std::str::FromStr>(s: &str) -> Result<T, String> {
-    s.parse().map_err(|_| format!("not a number: {s}"))
-}
-
-fn list<T: std::str::FromStr>(s: &str) -> Result<Vec<T>, String> {
-    s.split(',').map(number).collect()
-}
-
-fn v_split(s: &str) -> Vec<String> {
-    s.split(',').map(str::to_string).collect()
-}
-
 fn main() {
-    // `cargo bench` adds `--bench`; it means nothing here.
-    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    let args = common::cli::bench_args();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    if args.iter().any(|a| a == "--help" || a == "-h") {
+    if common::cli::wants_help(&args) {
         println!("{USAGE}");
         return;
     }
@@ -127,23 +118,8 @@ fn main() {
             std::process::exit(2);
         }
     };
-    let command = if args.is_empty() {
-        "cargo bench --bench table1".to_string()
-    } else {
-        format!("cargo bench --bench table1 -- {}", args.join(" "))
-    };
-    match run(&options, &root, command) {
-        Ok(report) => {
-            let block = report.markdown();
-            println!("{block}");
-            if options.write {
-                let doc = root.join("docs").join("benchmarks.md");
-                match report::write_into(&doc, &block) {
-                    Ok(()) => eprintln!("table1: wrote docs/benchmarks.md"),
-                    Err(e) => eprintln!("table1: cannot write {}: {e}", doc.display()),
-                }
-            }
-        }
+    match run(&options, &root, common::cli::command("table1", &args)) {
+        Ok(report) => common::report::publish(&root, "table1", &report.markdown(), options.write),
         Err(e) => {
             eprintln!("table1: {e}");
             std::process::exit(1);
@@ -166,7 +142,7 @@ fn memory_child(args: &[String], root: &Path) {
 /// Runs every measurement and gathers the report.
 fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
     let start = Instant::now();
-    let load_start = report::load_average();
+    let load_start = common::report::load_average();
     let threads = Threads::new(o.threads)?;
     let mut rows = Vec::new();
     let mut methods = Vec::new();
@@ -191,12 +167,12 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
     }
 
     let mut one_thread = Vec::new();
-    let (surface_name, surface) = inputs::cloud_surface(&o.data);
+    let (surface_name, surface) = common::inputs::cloud_surface(&o.data);
     let largest = o.big.iter().copied().max();
     for &count in &o.big {
         eprintln!("table1: {count} samples on {surface_name}");
         let input = Input {
-            name: format!("{surface_name} {}", inputs::short_count(count)),
+            name: format!("{surface_name} {}", common::inputs::short_count(count)),
             path: None,
             mesh: None,
             samples: inputs::cloud(&surface, count),
@@ -244,17 +220,12 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
             big_runs: o.big_runs,
             threads: o.threads,
             load_start,
-            load_end: report::load_average(),
+            load_end: common::report::load_average(),
             seconds: start.elapsed().as_secs_f64(),
             cloud_surface: surface_name,
             notes,
         },
     })
-}
-
-/// `path` as the doc should show it: relative to the project root when possible.
-fn shown(path: &Path, root: &Path) -> String {
-    path.strip_prefix(root).unwrap_or(path).display().to_string()
 }
 
 /// Table rows of one input at every bound and, for meshes, its octree and VS-Tree

@@ -1,9 +1,10 @@
 //! Timings and figures: tree builds, simplifications, and distances to the input.
 
+use crate::common::distance::{self, Distances};
+use crate::common::stats::median;
 use glam::Vec3;
 use std::time::Instant;
-use vstree::distance::{one_sided, Target};
-use vstree::shapes::sample_surface;
+use vstree::distance::Target;
 use vstree::tree::{self, NodeKind, TreeKind, TreeParams, TreeStats, VsTree};
 use vstree::{simplify, Mesh, MeshSampling, Progress, SampleSet, SimplifyParams, Threads};
 
@@ -13,17 +14,6 @@ pub const KINDS: [TreeKind; 2] = [TreeKind::Octree, TreeKind::VsTree];
 /// Tree parameters: the paper's defaults with the L2 metric at `bound`.
 pub fn params(kind: TreeKind, bound: f64) -> TreeParams {
     TreeParams { kind, error: bound, ..TreeParams::default() }
-}
-
-/// The median of `values` (mean of the two middle ones for an even count; 0 when empty).
-pub fn median(values: &[f64]) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => v[n / 2],
-        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
 }
 
 /// One tree kind's build on one input at one bound.
@@ -122,33 +112,8 @@ pub fn simplified(mesh: &Mesh, kind: TreeKind, bound: f64, threads: usize, runs:
     Ok(Simplified { mesh: out, seconds: median(&times) })
 }
 
-/// Points sampled on a simplified surface to measure its distance to the input.
-const SURFACE_SAMPLES: usize = 200_000;
-
-/// Distances between a simplified mesh and its input, relative to the input's bounding-box
-/// diagonal. `None` where a side is empty.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Distances {
-    /// From [`SURFACE_SAMPLES`] points uniform on the output's surface to the input's triangles.
-    pub out_in: Option<(f64, f64)>,
-    /// From the input's samples (its used vertices) to the output's triangles: catches what the
-    /// output lost (holes, thin parts).
-    pub in_out: Option<(f64, f64)>,
-}
-
-/// [`Distances`] of `output` to `input` (whose samples are `input_points`, box diagonal
-/// `diagonal`), with `vstree::distance`.
+/// [`Distances`] of the simplified `output` to `input` (whose samples are `input_points`, box
+/// diagonal `diagonal`): from points on the output to the input's triangles, and back.
 pub fn distances(input: &Mesh, input_points: &[Vec3], diagonal: f32, output: &Mesh) -> Distances {
-    let relative = |from: &[Vec3], to: Target| {
-        let s = one_sided(from, to);
-        (s.count > 0 && s.max.is_finite()).then(|| {
-            let d = f64::from(diagonal);
-            (f64::from(s.mean) / d, f64::from(s.max) / d)
-        })
-    };
-    let on_output = sample_surface(output, SURFACE_SAMPLES, 31).positions;
-    Distances {
-        out_in: relative(&on_output, Target::Triangles(input)),
-        in_out: if output.triangles.is_empty() { None } else { relative(input_points, Target::Triangles(output)) },
-    }
+    distance::between(output, Target::Triangles(input), input_points, diagonal)
 }

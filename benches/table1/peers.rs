@@ -1,8 +1,8 @@
 //! The peers (PyMeshLab's clustering and quadric edge collapse), run by `benches/peers.py` at
 //! the VS-Tree's output size; their outputs are read back so the Rust side measures distances.
 
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
 /// One peer's run at one target size.
 #[derive(Clone, Debug)]
@@ -22,43 +22,29 @@ pub struct PeerRun {
 /// Runs the peers on the mesh file `input` for each of `targets` (triangle counts), `runs`
 /// timed runs each. The script's progress goes to this process's stderr.
 pub fn run(root: &Path, input: &Path, name: &str, targets: &[usize], runs: usize) -> Result<Vec<PeerRun>, String> {
-    let script = root.join("benches").join("peers.py");
-    let out_dir = root.join("target").join("bench-peers");
-    let mut command = Command::new("python3");
-    command
-        .arg(&script)
-        .arg("--input")
-        .arg(input)
-        .args(["--runs", &runs.to_string(), "--name", name])
-        .arg("--out-dir")
-        .arg(&out_dir);
+    let mut args: Vec<OsString> = vec!["--input".into(), input.into()];
+    args.extend(["--runs".into(), runs.to_string().into(), "--name".into(), name.into()]);
+    args.extend(["--out-dir".into(), root.join("target").join("bench-peers").into()]);
     for target in targets {
-        command.args(["--target", &target.to_string()]);
+        args.extend(["--target".into(), target.to_string().into()]);
     }
-    let output = command
-        .stderr(Stdio::inherit())
-        .output()
-        .map_err(|e| format!("cannot run python3 {}: {e}", script.display()))?;
-    if !output.status.success() {
-        return Err(format!("{} failed ({})", script.display(), output.status));
-    }
-    let runs: Vec<PeerRun> = String::from_utf8_lossy(&output.stdout).lines().filter_map(parse).collect();
+    let runs: Vec<PeerRun> =
+        crate::common::peers::run(root, "peers.py", &args)?.iter().filter_map(|r| parse(r)).collect();
     if runs.is_empty() {
-        return Err(format!("{} reported nothing", script.display()));
+        return Err("benches/peers.py reported no peer".into());
     }
     Ok(runs)
 }
 
-/// A `peer <method> <target> <faces> <seconds> <parameter> <path>` line.
-fn parse(line: &str) -> Option<PeerRun> {
-    let f: Vec<&str> = line.split('\t').collect();
-    match f[..] {
-        ["peer", method, target, faces, seconds, parameter, path] => Some(PeerRun {
-            method: method.to_string(),
+/// A `peer <method> <target> <faces> <seconds> <parameter> <path>` record.
+fn parse(record: &[String]) -> Option<PeerRun> {
+    match record {
+        [peer, method, target, faces, seconds, parameter, path] if peer == "peer" => Some(PeerRun {
+            method: method.clone(),
             target: target.parse().ok()?,
             faces: faces.parse().ok()?,
             seconds: seconds.parse().ok()?,
-            parameter: parameter.to_string(),
+            parameter: parameter.clone(),
             output: PathBuf::from(path),
         }),
         _ => None,

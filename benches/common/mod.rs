@@ -1,0 +1,16 @@
+//! What the table benches (`benches/table1`, `benches/table2`) share: command-line helpers,
+//! inputs drawn on a surface, distances relative to the diagonal, the Markdown report's header
+//! and formatting, peak memory in a child process, and the Python peers' plumbing.
+//!
+//! Each bench includes this directory with `#[path = "../common/mod.rs"] mod common;`.
+
+// Every bench binary compiles all of this but uses only a part.
+#![allow(dead_code)]
+
+pub mod cli;
+pub mod distance;
+pub mod inputs;
+pub mod memory;
+pub mod peers;
+pub mod report;
+pub mod stats;
