@@ -89,7 +89,17 @@ fn tetrahedron(
     let is_in: [bool; 4] = corners.map(|c| inside[c as usize]);
     // The vertex on the edge between tet corners x and y.
     let mut edge = |x: usize, y: usize| vertex(corners[x.min(y)], corners[x.max(y)]);
-    let (ins, outs): (Vec<usize>, Vec<usize>) = (0..4).partition(|&v| is_in[v]);
+    // The tet's inside corners first, then its outside ones, each in order.
+    let mut order = [0usize; 4];
+    let mut inside_count = 0;
+    for v in (0..4).filter(|&v| is_in[v]) {
+        order[inside_count] = v;
+        inside_count += 1;
+    }
+    for (slot, v) in (inside_count..4).zip((0..4).filter(|&v| !is_in[v])) {
+        order[slot] = v;
+    }
+    let (ins, outs) = order.split_at(inside_count);
     let orient = |mut tri: [u32; 3], flip: bool| {
         if flip {
             tri.swap(1, 2);
@@ -99,13 +109,13 @@ fn tetrahedron(
     match ins.len() {
         1 => {
             // The triangle must face away from the single inside corner.
-            let (i, o) = (ins[0], &outs);
+            let (i, o) = (ins[0], outs);
             let flip = odd_tet ^ is_odd_permutation([i, o[0], o[1], o[2]]);
             out.push(orient([edge(i, o[0]).0, edge(i, o[1]).0, edge(i, o[2]).0], flip));
         }
         3 => {
             // The triangle must face towards the single outside corner.
-            let (o, i) = (outs[0], &ins);
+            let (o, i) = (outs[0], ins);
             let flip = !(odd_tet ^ is_odd_permutation([o, i[0], i[1], i[2]]));
             out.push(orient([edge(o, i[0]).0, edge(o, i[1]).0, edge(o, i[2]).0], flip));
         }
@@ -166,7 +176,7 @@ impl Grid {
     }
 }
 
-/// A fast hasher for the packed grid keys (multiplicative, like FxHash).
+/// A fast hasher for the packed grid keys (multiplicative, like FxHash, rotated at the end).
 #[derive(Default)]
 struct KeyHasher(u64);
 
@@ -183,7 +193,11 @@ impl Hasher for KeyHasher {
         self.0 = (self.0.rotate_left(5) ^ x).wrapping_mul(0x517c_c1b7_2722_0a95);
     }
     fn finish(&self) -> u64 {
-        self.0
+        // A product's low bits depend only on the factors' low bits: unrotated, the table's
+        // bucket (the low bits) would come from the x coordinate alone and every key with the
+        // same x would share one probe sequence. The rotation brings the well-mixed middle
+        // bits down.
+        self.0.rotate_left(26)
     }
 }
 
@@ -192,6 +206,77 @@ type FastSet<K> = HashSet<K, BuildHasherDefault<KeyHasher>>;
 
 /// The six faces of a cube: the axis bit, and whether it is the face where that bit is set.
 const FACES: [(u8, bool); 6] = [(1, false), (1, true), (2, false), (2, true), (4, false), (4, true)];
+
+/// The grid point at corner `c` (bits x = 1, y = 2, z = 4) of `cell`.
+fn corner(cell: [u32; 3], c: u8) -> [u32; 3] {
+    [cell[0] + u32::from(c & 1), cell[1] + u32::from(c >> 1 & 1), cell[2] + u32::from(c >> 2 & 1)]
+}
+
+/// Cells per parallel task when triangulating one wave of the surface tracking.
+const WAVE_CHUNK: usize = 2048;
+
+/// The triangles of a run of cells, with vertices local to the run: `edges[v]` is vertex v's
+/// grid edge (its lower point's key and the corner bits it spans) and position. Vertices on
+/// the same edge are merged when the runs are put together.
+#[derive(Default)]
+struct WaveChunk {
+    edges: Vec<((u64, u8), Vec3)>,
+    triangles: Vec<[u32; 3]>,
+    /// Cells that share a face crossing the surface with one of the run's cells.
+    neighbours: Vec<u64>,
+}
+
+/// Triangulates `cells` (every corner already in `values`) and lists where the surface goes on.
+fn triangulate_cells(cells: &[u64], grid: &Grid, values: &FastMap<u64, f32>) -> WaveChunk {
+    let mut out = WaveChunk::default();
+    for &c in cells {
+        let cell = Grid::unkey(c);
+        let corner_values: [f32; 8] = std::array::from_fn(|k| {
+            let [i, j, l] = corner(cell, k as u8);
+            values[&Grid::key(i, j, l)]
+        });
+        if corner_values.iter().any(|v| v.is_nan()) {
+            continue;
+        }
+        let inside = corner_values.map(|v| v < 0.0);
+        let inside_bits = (0..8).filter(|&k| inside[k]).fold(0u8, |bits, k| bits | 1 << k);
+        if inside_bits == 0 || inside_bits == u8::MAX {
+            continue;
+        }
+        let edges = &mut out.edges;
+        cube_triangles(
+            &inside,
+            |lower, upper| {
+                let (a, b) = (corner(cell, lower), corner(cell, upper));
+                let t = crossing_fraction(corner_values[lower as usize], corner_values[upper as usize]);
+                let (pa, pb) = (grid.point(a), grid.point(b));
+                let p = pa + (pb - pa) * t;
+                edges.push(((Grid::key(a[0], a[1], a[2]), upper ^ lower), p));
+                ((edges.len() - 1) as u32, p)
+            },
+            &mut out.triangles,
+        );
+        for (bit, upper) in FACES {
+            // The face's four corners, as a bit set over the cube's eight.
+            let face = (0..8u8).filter(|k| (k & bit != 0) == upper).fold(0u8, |bits, k| bits | 1 << k);
+            let face_inside = inside_bits & face;
+            if face_inside == 0 || face_inside == face {
+                continue;
+            }
+            let axis = bit.trailing_zeros() as usize;
+            let mut n = cell;
+            if upper {
+                n[axis] += 1;
+            } else if n[axis] == 0 {
+                continue;
+            } else {
+                n[axis] -= 1;
+            }
+            out.neighbours.push(Grid::key(n[0], n[1], n[2]));
+        }
+    }
+    out
+}
 
 /// Polygonises the part of the zero set of `f` (negative inside) that passes through the
 /// `seeds` cells, by surface tracking (Bloomenthal 1994): a cell is visited when it shares a
@@ -224,92 +309,57 @@ pub(crate) fn track_surface(
     let mut vertices: FastMap<(u64, u8), u32> = FastMap::default();
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
-    let corner = |cell: [u32; 3], c: u8| {
-        [cell[0] + u32::from(c & 1), cell[1] + u32::from(c >> 1 & 1), cell[2] + u32::from(c >> 2 & 1)]
-    };
 
     while !frontier.is_empty() {
         if visited.len() > max_cells {
             return Err(Error::TooLarge(format!("the surface crosses more than {max_cells} grid cells")));
         }
         // Evaluate the corners not seen yet, in parallel.
-        let mut needed: Vec<u64> = frontier
-            .iter()
-            .flat_map(|&c| {
-                let cell = Grid::unkey(c);
-                (0..8u8).map(move |k| {
-                    let [i, j, l] = corner(cell, k);
-                    Grid::key(i, j, l)
-                })
-            })
-            .filter(|p| !values.contains_key(p))
-            .collect();
-        needed.sort_unstable();
-        needed.dedup();
-        let computed: Vec<f32> = threads.run(|| {
-            needed
+        let computed: Vec<(u64, f32)> = threads.run(|| {
+            let mut needed: Vec<u64> = frontier
                 .par_iter()
-                .map(|&p| {
+                .flat_map_iter(|&c| {
+                    let cell = Grid::unkey(c);
+                    (0..8u8).map(move |k| {
+                        let [i, j, l] = corner(cell, k);
+                        Grid::key(i, j, l)
+                    })
+                })
+                .filter(|p| !values.contains_key(p))
+                .collect();
+            needed.par_sort_unstable();
+            needed.dedup();
+            needed
+                .into_par_iter()
+                .map(|p| {
                     let ijk = Grid::unkey(p);
-                    if grid.on_border(ijk) {
-                        f32::MAX
-                    } else {
-                        f(grid.point(ijk))
-                    }
+                    (p, if grid.on_border(ijk) { f32::MAX } else { f(grid.point(ijk)) })
                 })
                 .collect()
         });
-        values.extend(needed.into_iter().zip(computed));
+        values.extend(computed);
 
-        // Triangulate the wave's cells in order and collect the next wave.
+        // Triangulate the wave's cells in parallel, in chunks whose results are then merged in
+        // order: the output does not depend on the number of threads.
+        let chunks: Vec<WaveChunk> = threads
+            .run(|| frontier.par_chunks(WAVE_CHUNK).map(|cells| triangulate_cells(cells, grid, &values)).collect());
         let mut next = Vec::new();
-        for &c in &frontier {
-            let cell = Grid::unkey(c);
-            let value = |k: u8| {
-                let [i, j, l] = corner(cell, k);
-                values[&Grid::key(i, j, l)]
-            };
-            let values: [f32; 8] = std::array::from_fn(|k| value(k as u8));
-            let inside = values.map(|v| v < 0.0);
-            if values.iter().any(|v| v.is_nan()) || inside.iter().all(|&x| x == inside[0]) {
-                continue;
-            }
-            cube_triangles(
-                &inside,
-                |lower, upper| {
-                    let a = corner(cell, lower);
-                    let key = (Grid::key(a[0], a[1], a[2]), upper ^ lower);
-                    if let Some(&v) = vertices.get(&key) {
-                        return (v, positions[v as usize]);
-                    }
-                    let b = corner(cell, upper);
-                    let t = crossing_fraction(value(lower), value(upper));
-                    let (pa, pb) = (grid.point(a), grid.point(b));
-                    let p = pa + (pb - pa) * t;
-                    let v = positions.len() as u32;
-                    positions.push(p);
-                    vertices.insert(key, v);
-                    (v, p)
-                },
-                &mut triangles,
-            );
-            for (bit, upper) in FACES {
-                let face: Vec<bool> =
-                    (0..8u8).filter(|k| (k & bit != 0) == upper).map(|k| inside[k as usize]).collect();
-                if face.iter().all(|&x| x == face[0]) {
-                    continue;
-                }
-                let axis = bit.trailing_zeros() as usize;
-                let mut n = cell;
-                if upper {
-                    n[axis] += 1;
-                } else if n[axis] == 0 {
-                    continue;
-                } else {
-                    n[axis] -= 1;
-                }
-                if n[axis] < cells_per_axis[axis] && visited.insert(Grid::key(n[0], n[1], n[2])) {
-                    next.push(Grid::key(n[0], n[1], n[2]));
+        for chunk in chunks {
+            let global: Vec<u32> = chunk
+                .edges
+                .iter()
+                .map(|&(key, p)| {
+                    *vertices.entry(key).or_insert_with(|| {
+                        positions.push(p);
+                        (positions.len() - 1) as u32
+                    })
+                })
+                .collect();
+            triangles.extend(chunk.triangles.iter().map(|t| t.map(|v| global[v as usize])));
+            for n in chunk.neighbours {
+                let [i, j, l] = Grid::unkey(n);
+                if i < cells_per_axis[0] && j < cells_per_axis[1] && l < cells_per_axis[2] && visited.insert(n) {
+                    next.push(n);
                 }
             }
         }
