@@ -12,6 +12,7 @@
 use crate::mesh::Mesh;
 use crate::tree::{NodeKind, VsTree};
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 use std::collections::VecDeque;
 
 /// No T-node.
@@ -61,14 +62,16 @@ const MIN_T_NODES_PER_COMPONENT: usize = 4;
 
 /// See [`stray_components`].
 const MIN_NEAR_SHARE: f64 = 0.25;
+const NEAR_PROBES: usize = 1000;
 
 /// Marks the vertices of components that span fewer than [`MIN_T_NODES_PER_COMPONENT`]
-/// T-nodes, or with fewer than [`MIN_NEAR_SHARE`] of their vertices `near_samples`: a shell
+/// T-nodes, or with fewer than [`MIN_NEAR_SHARE`] of their vertices `near_samples` (judged
+/// on up to [`NEAR_PROBES`] of them, evenly spread through the component): a shell
 /// that the winding number put away from the samples, such as a bubble inside the tube of a
 /// sparsely sampled torus, where the few samples' areas are rough. A real surface runs through
 /// its samples: a closed scan almost everywhere, and even the closed blob around a single
 /// open range scan on its front side, about half of it.
-fn stray_components(mesh: &Mesh, labels: &[u32], near_samples: &[bool]) -> Vec<bool> {
+fn stray_components(mesh: &Mesh, labels: &[u32], near_samples: &(dyn Fn(Vec3) -> bool + Sync)) -> Vec<bool> {
     let neighbours = vertex_neighbours(mesh);
     let mut component = vec![u32::MAX; mesh.positions.len()];
     let mut dropped = vec![false; mesh.positions.len()];
@@ -91,8 +94,10 @@ fn stray_components(mesh: &Mesh, labels: &[u32], near_samples: &[bool]) -> Vec<b
         let mut t_nodes: Vec<u32> = members.iter().map(|&v| labels[v as usize]).collect();
         t_nodes.sort_unstable();
         t_nodes.dedup();
-        let near = members.iter().filter(|&&v| near_samples[v as usize]).count();
-        if t_nodes.len() < MIN_T_NODES_PER_COMPONENT || (near as f64) < MIN_NEAR_SHARE * members.len() as f64 {
+        let probes: Vec<Vec3> =
+            members.iter().step_by(members.len().div_ceil(NEAR_PROBES)).map(|&v| mesh.positions[v as usize]).collect();
+        let near = probes.par_iter().filter(|&&p| near_samples(p)).count();
+        if t_nodes.len() < MIN_T_NODES_PER_COMPONENT || (near as f64) < MIN_NEAR_SHARE * probes.len() as f64 {
             for &v in &members {
                 dropped[v as usize] = true;
             }
@@ -110,7 +115,11 @@ pub(crate) struct BaseMesh {
 /// Collapses every edge whose ends share a label, while the link condition allows, and places
 /// each remaining vertex at the mean of the fine vertices it absorbed. Stray components
 /// (bubbles of the implicit function, see [`stray_components`]) are dropped.
-pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], near_samples: &[bool]) -> BaseMesh {
+pub(crate) fn cluster_at_t_layer(
+    fine: &Mesh,
+    labels: &[u32],
+    near_samples: &(dyn Fn(Vec3) -> bool + Sync),
+) -> BaseMesh {
     let mut c = Collapser::new(fine);
     let dropped = stray_components(fine, labels, near_samples);
     for (t, tri) in fine.triangles.iter().enumerate() {
@@ -121,15 +130,31 @@ pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], near_samples: &[bo
             }
         }
     }
+    // Collapse in rounds, each vertex in at most one collapse per round (a greedy matching),
+    // so clusters shrink evenly and rings stay small; merging everything into one growing
+    // vertex instead makes every link test cost the cluster's whole perimeter.
+    let same_label = |t: &[u32; 3]| (0..3).any(|k| labels[t[k] as usize] == labels[t[(k + 1) % 3] as usize]);
+    let mut candidates: Vec<u32> = (0..c.triangles.len() as u32)
+        .filter(|&t| c.alive_face[t as usize] && same_label(&c.triangles[t as usize]))
+        .collect();
+    let mut touched = vec![false; fine.positions.len()];
     loop {
         let mut collapsed = 0usize;
-        for t in 0..c.triangles.len() {
+        touched.fill(false);
+        for &t in &candidates {
             for k in 0..3 {
-                if !c.alive_face[t] {
+                if !c.alive_face[t as usize] {
                     break;
                 }
-                let (u, v) = (c.triangles[t][k], c.triangles[t][(k + 1) % 3]);
-                if labels[u as usize] == labels[v as usize] && c.try_collapse(u.max(v), u.min(v)) {
+                let tri = c.triangles[t as usize];
+                let (u, v) = (tri[k], tri[(k + 1) % 3]);
+                if labels[u as usize] == labels[v as usize]
+                    && !touched[u as usize]
+                    && !touched[v as usize]
+                    && c.try_collapse(u.max(v), u.min(v))
+                {
+                    touched[u as usize] = true;
+                    touched[v as usize] = true;
                     collapsed += 1;
                 }
             }
@@ -137,6 +162,7 @@ pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], near_samples: &[bo
         if collapsed == 0 {
             break;
         }
+        candidates.retain(|&t| c.alive_face[t as usize] && same_label(&c.triangles[t as usize]));
     }
     c.finish(labels)
 }
@@ -150,6 +176,8 @@ struct Collapser {
     alive_vertex: Vec<bool>,
     sum: Vec<DVec3>,
     count: Vec<u32>,
+    /// Scratch space for the two rings of the link test.
+    rings: (Vec<u32>, Vec<u32>),
 }
 
 impl Collapser {
@@ -167,20 +195,22 @@ impl Collapser {
             alive_vertex: vec![true; mesh.positions.len()],
             sum: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
             count: vec![1; mesh.positions.len()],
+            rings: Default::default(),
         }
     }
 
-    /// The other vertices of the live faces around `v`, sorted and unique.
-    fn ring(&self, v: u32) -> Vec<u32> {
-        let mut ring: Vec<u32> = self.faces_of[v as usize]
-            .iter()
-            .filter(|&&f| self.alive_face[f as usize])
-            .flat_map(|&f| self.triangles[f as usize])
-            .filter(|&w| w != v)
-            .collect();
+    /// Puts the other vertices of the live faces around `v` into `ring`, sorted and unique.
+    fn ring_into(&self, v: u32, ring: &mut Vec<u32>) {
+        ring.clear();
+        ring.extend(
+            self.faces_of[v as usize]
+                .iter()
+                .filter(|&&f| self.alive_face[f as usize])
+                .flat_map(|&f| self.triangles[f as usize])
+                .filter(|&w| w != v),
+        );
         ring.sort_unstable();
         ring.dedup();
-        ring
     }
 
     /// Merges `u` into `v` if the edge exists and the link condition holds.
@@ -188,18 +218,28 @@ impl Collapser {
         if !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
             return false;
         }
-        let shared: Vec<u32> = self.faces_of[u as usize]
-            .iter()
-            .copied()
-            .filter(|&f| self.alive_face[f as usize] && self.triangles[f as usize].contains(&v))
-            .collect();
-        if shared.len() != 2 {
+        let mut shared = [0u32; 2];
+        let mut shared_count = 0;
+        for &f in &self.faces_of[u as usize] {
+            if self.alive_face[f as usize] && self.triangles[f as usize].contains(&v) {
+                if shared_count == 2 {
+                    return false; // more than two faces on the edge: not a manifold edge
+                }
+                shared[shared_count] = f;
+                shared_count += 1;
+            }
+        }
+        if shared_count != 2 {
             return false; // not an edge of a closed manifold (or no edge at all)
         }
-        let (ring_u, ring_v) = (self.ring(u), self.ring(v));
+        let (mut ring_u, mut ring_v) = std::mem::take(&mut self.rings);
+        self.ring_into(u, &mut ring_u);
+        self.ring_into(v, &mut ring_v);
         let common = ring_u.iter().filter(|w| ring_v.binary_search(w).is_ok()).count();
         // Link condition; and never shrink a closed component below a tetrahedron.
-        if common != 2 || ring_u.len() + ring_v.len() <= 6 {
+        let allowed = common == 2 && ring_u.len() + ring_v.len() > 6;
+        self.rings = (ring_u, ring_v);
+        if !allowed {
             return false;
         }
         for &f in &shared {
@@ -265,7 +305,7 @@ mod tests {
             (crate::shapes::double_torus(), 2),
         ] {
             // Eight clusters, the octants: collapse as far as topology allows.
-            let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), &vec![true; mesh.positions.len()]);
+            let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), &|_| true);
             let r = analyze(&base.mesh);
             assert!(r.is_watertight(), "{r:?}");
             assert_eq!(r.genus(), Some(genus));
@@ -276,7 +316,7 @@ mod tests {
     #[test]
     fn components_spanning_fewer_than_four_t_nodes_are_dropped() {
         let mesh = crate::shapes::icosphere(1.0, 2);
-        let base = cluster_at_t_layer(&mesh, &vec![0; mesh.positions.len()], &vec![true; mesh.positions.len()]);
+        let base = cluster_at_t_layer(&mesh, &vec![0; mesh.positions.len()], &|_| true);
         assert!(base.mesh.positions.is_empty() && base.mesh.triangles.is_empty());
     }
 
@@ -284,7 +324,7 @@ mod tests {
     fn labels_partition_a_sphere_into_clusters() {
         let mesh = crate::shapes::icosphere(1.0, 4);
         // Eight clusters: the octants.
-        let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), &vec![true; mesh.positions.len()]);
+        let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), &|_| true);
         let r = analyze(&base.mesh);
         assert!(r.is_watertight() && r.genus() == Some(0));
         assert_eq!(base.mesh.positions.len(), 8, "one vertex per octant");
