@@ -394,6 +394,19 @@ impl PointBvh {
         Some((d2.sqrt(), self.bvh.order[position]))
     }
 
+    /// The nearest point to `p` among those whose input index passes `keep`, as
+    /// [`PointBvh::nearest`] gives it.
+    pub fn nearest_among(&self, p: Vec3, keep: impl Fn(u32) -> bool) -> Option<(f32, u32)> {
+        let (position, d2) = self.bvh.nearest(p, |position| {
+            if keep(self.bvh.order[position]) {
+                self.points[position].distance_squared(p)
+            } else {
+                f32::INFINITY
+            }
+        })?;
+        Some((d2.sqrt(), self.bvh.order[position]))
+    }
+
     /// Distance from `p` to the nearest point: `f32::INFINITY` for an empty cloud, NaN when `p`
     /// has a NaN coordinate.
     pub fn distance(&self, p: Vec3) -> f32 {

@@ -184,8 +184,16 @@ pub fn reconstruct(
     let t1 = Instant::now();
 
     progress.report(0.35, "base mesh")?;
-    let near = threads.run(|| PointBvh::new(&samples.positions));
-    let spacing = sample_spacing(&samples.positions);
+    {
+        let mut h = [0usize; 16];
+        for n in tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition) {
+            h[n.depth as usize] += 1;
+        }
+    }
+    // The tree's order keeps neighbours together in memory, which makes the build faster.
+    let tree_order: Vec<Vec3> = tree.samples.iter().map(|s| s.position).collect();
+    let near = threads.run(|| PointBvh::new(&tree_order));
+    let spacing = sample_spacing(&near, &tree_order);
     let grid = polygonisation_grid(&tree, params.max_grid_depth, spacing);
     stats.grid_cells = grid.dims[0] - 5;
     let seeds = sample_cells(&grid, &samples.positions, &threads);
@@ -229,9 +237,8 @@ pub fn reconstruct(
     stats.fine_triangles = fine.triangles.len();
     progress.report(0.4, "base mesh")?;
     let labels = base_mesh::label_vertices(&tree, &fine);
-    let near_samples: Vec<bool> =
-        threads.run(|| fine.positions.par_iter().map(|&p| near.distance(p) <= tolerance).collect());
-    let base = base_mesh::cluster_at_t_layer(&fine, &labels, &near_samples);
+    let near_samples = |p: Vec3| near.distance(p) <= tolerance;
+    let base = threads.run(|| base_mesh::cluster_at_t_layer(&fine, &labels, &near_samples));
     stats.base_vertices = base.mesh.positions.len();
     stats.base_triangles = base.mesh.triangles.len();
     stats.base_genus = topology::analyze(&base.mesh).genus();
@@ -302,12 +309,16 @@ fn median(mut values: Vec<f32>) -> f32 {
 }
 
 /// The typical distance between neighbouring samples: the median, over up to 2,000 of the odd
-/// samples, of the distance to the nearest even sample.
-fn sample_spacing(points: &[Vec3]) -> f32 {
-    let even: Vec<Vec3> = points.iter().step_by(2).copied().collect();
-    let bvh = PointBvh::new(&even);
+/// points, of the distance to the nearest even point (`near` holds `points`).
+fn sample_spacing(near: &PointBvh, points: &[Vec3]) -> f32 {
     let odd: Vec<Vec3> = points.iter().skip(1).step_by(2).copied().collect();
-    median(evenly_spread(&odd, 2000).iter().map(|&p| bvh.distance(p)).filter(|d| d.is_finite()).collect())
+    median(
+        evenly_spread(&odd, 2000)
+            .iter()
+            .filter_map(|&p| near.nearest_among(p, |i| i % 2 == 0).map(|(d, _)| d))
+            .filter(|d| d.is_finite())
+            .collect(),
+    )
 }
 
 /// The grid cells that hold samples: where the surface tracking starts.

@@ -14,7 +14,7 @@
 //! square), the face of a V-node's cube. Cells, unlike sample counts, do not depend on how
 //! densely a region was scanned, so overlapping scans do not weigh twice.
 
-use crate::tree::{NodeKind, VsTree};
+use crate::tree::{NodeKind, VsTree, MAX_DEPTH};
 use glam::{Vec2, Vec3};
 
 /// A node farther than this many times its radius is summed as one dipole.
@@ -71,8 +71,12 @@ impl<'t> WindingNumber<'t> {
     /// The winding number at `p`: near 1 inside the sampled surface, near 0 outside.
     pub fn at(&self, p: Vec3) -> f32 {
         let mut sum = 0.0f32;
-        let mut stack = vec![0usize];
-        while let Some(i) = stack.pop() {
+        // Depth-first, at most eight children pushed per level: a fixed stack, no allocation.
+        let mut stack = [0u32; 8 * (MAX_DEPTH as usize + 1)];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let i = stack[top] as usize;
             let node = &self.tree.nodes[i];
             let d = self.centre[i] - p;
             let dist = d.length();
@@ -84,7 +88,10 @@ impl<'t> WindingNumber<'t> {
                 let a = self.sample_area[i];
                 sum += self.tree.samples_of(node).iter().map(|s| dipole(s.normal * a, s.position - p)).sum::<f32>();
             } else {
-                stack.extend(node.children());
+                for c in node.children() {
+                    stack[top] = c as u32;
+                    top += 1;
+                }
             }
         }
         sum
