@@ -63,7 +63,8 @@ enum Command {
         #[arg(long, default_value_t = 6)]
         levels: u32,
         /// Remove faces farther than this many grid cells from every sample, so an open scan
-        /// gives an open mesh (0 = keep the closed surface).
+        /// gives an open mesh (0 = keep the closed surface). Use it for single range scans:
+        /// above 0 the surface that closes the scan is put well behind it, where it is trimmed.
         #[arg(long, default_value_t = 0.0)]
         trim: f32,
         /// Re-orient the normals the cloud already has (consistent by spanning-tree

@@ -12,7 +12,6 @@
 use crate::mesh::Mesh;
 use crate::tree::{NodeKind, VsTree};
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 use std::collections::VecDeque;
 
 /// No T-node.
@@ -60,18 +59,13 @@ fn vertex_neighbours(mesh: &Mesh) -> Vec<Vec<u32>> {
 /// cannot be represented at the T-layer (it is a bubble of the implicit function).
 const MIN_T_NODES_PER_COMPONENT: usize = 4;
 
-/// See [`stray_components`].
-const MIN_NEAR_SHARE: f64 = 0.25;
-const NEAR_PROBES: usize = 1000;
-
 /// Marks the vertices of components that span fewer than [`MIN_T_NODES_PER_COMPONENT`]
-/// T-nodes, or with fewer than [`MIN_NEAR_SHARE`] of their vertices `near_samples` (judged
-/// on up to [`NEAR_PROBES`] of them, evenly spread through the component): a shell
-/// that the winding number put away from the samples, such as a bubble inside the tube of a
-/// sparsely sampled torus, where the few samples' areas are rough. A real surface runs through
-/// its samples: a closed scan almost everywhere, and even the closed blob around a single
-/// open range scan on its front side, about half of it.
-fn stray_components(mesh: &Mesh, labels: &[u32], near_samples: &(dyn Fn(Vec3) -> bool + Sync)) -> Vec<bool> {
+/// T-nodes, or that fit in a box of two grid cells (`cell`) a side. The latter is the
+/// polygoniser's smallest closed shell: one grid point whose sign differs from all its
+/// neighbours', wrapped in the 14 vertices of its star. It is below the grid's resolution,
+/// so it is not a part of the surface that the grid resolves but a bubble of the implicit
+/// function, such as the winding number leaves inside the tube of a sparsely sampled torus.
+fn stray_components(mesh: &Mesh, labels: &[u32], cell: f32) -> Vec<bool> {
     let neighbours = vertex_neighbours(mesh);
     let mut component = vec![u32::MAX; mesh.positions.len()];
     let mut dropped = vec![false; mesh.positions.len()];
@@ -94,10 +88,12 @@ fn stray_components(mesh: &Mesh, labels: &[u32], near_samples: &(dyn Fn(Vec3) ->
         let mut t_nodes: Vec<u32> = members.iter().map(|&v| labels[v as usize]).collect();
         t_nodes.sort_unstable();
         t_nodes.dedup();
-        let probes: Vec<Vec3> =
-            members.iter().step_by(members.len().div_ceil(NEAR_PROBES)).map(|&v| mesh.positions[v as usize]).collect();
-        let near = probes.par_iter().filter(|&&p| near_samples(p)).count();
-        if t_nodes.len() < MIN_T_NODES_PER_COMPONENT || (near as f64) < MIN_NEAR_SHARE * probes.len() as f64 {
+        let (low, high) = members
+            .iter()
+            .map(|&v| mesh.positions[v as usize])
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        let sub_resolution = (high - low).max_element() <= 2.0 * cell;
+        if t_nodes.len() < MIN_T_NODES_PER_COMPONENT || sub_resolution {
             for &v in &members {
                 dropped[v as usize] = true;
             }
@@ -115,13 +111,9 @@ pub(crate) struct BaseMesh {
 /// Collapses every edge whose ends share a label, while the link condition allows, and places
 /// each remaining vertex at the mean of the fine vertices it absorbed. Stray components
 /// (bubbles of the implicit function, see [`stray_components`]) are dropped.
-pub(crate) fn cluster_at_t_layer(
-    fine: &Mesh,
-    labels: &[u32],
-    near_samples: &(dyn Fn(Vec3) -> bool + Sync),
-) -> BaseMesh {
+pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], cell: f32) -> BaseMesh {
     let mut c = Collapser::new(fine);
-    let dropped = stray_components(fine, labels, near_samples);
+    let dropped = stray_components(fine, labels, cell);
     for (t, tri) in fine.triangles.iter().enumerate() {
         if tri.iter().any(|&v| labels[v as usize] == UNLABELLED || dropped[v as usize]) {
             c.alive_face[t] = false;
@@ -305,7 +297,7 @@ mod tests {
             (crate::shapes::double_torus(), 2),
         ] {
             // Eight clusters, the octants: collapse as far as topology allows.
-            let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), &|_| true);
+            let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), 0.0);
             let r = analyze(&base.mesh);
             assert!(r.is_watertight(), "{r:?}");
             assert_eq!(r.genus(), Some(genus));
@@ -316,7 +308,7 @@ mod tests {
     #[test]
     fn components_spanning_fewer_than_four_t_nodes_are_dropped() {
         let mesh = crate::shapes::icosphere(1.0, 2);
-        let base = cluster_at_t_layer(&mesh, &vec![0; mesh.positions.len()], &|_| true);
+        let base = cluster_at_t_layer(&mesh, &vec![0; mesh.positions.len()], 0.0);
         assert!(base.mesh.positions.is_empty() && base.mesh.triangles.is_empty());
     }
 
@@ -324,7 +316,7 @@ mod tests {
     fn labels_partition_a_sphere_into_clusters() {
         let mesh = crate::shapes::icosphere(1.0, 4);
         // Eight clusters: the octants.
-        let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), &|_| true);
+        let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), 0.0);
         let r = analyze(&base.mesh);
         assert!(r.is_watertight() && r.genus() == Some(0));
         assert_eq!(base.mesh.positions.len(), 8, "one vertex per octant");

@@ -152,6 +152,7 @@ impl<'t> Refiner<'t> {
         }
 
         smooth_tangentially(&mut out, old, &displaced);
+        self.project_undisplaced(&mut out, old as usize, &displaced);
         self.unfold(&mut out, old as usize);
         (out, LevelStats { new_vertices: placed.len(), displaced: moves.len() })
     }
@@ -170,6 +171,53 @@ impl<'t> Refiner<'t> {
                 s.positions[v] = snapped;
                 s.normals[v] = self.normal[leaf];
             }
+        }
+    }
+
+    /// Moves each new vertex that no leaf was left for along the normal onto the tangent plane
+    /// of the leaf under it, without locking the leaf. The PN patches and the tangential
+    /// smoothing put it near the surface, off by the curvature that the coarse vertices and
+    /// normals around it did not capture; sliding along the normal keeps its place in the
+    /// mesh, so several vertices can share a leaf without piling up (the aliasing that the
+    /// paper's locking avoids comes from moving to the leaf's average sample). Moves longer than
+    /// the leaf's half size are not made (the leaf would belong to another sheet), nor moves
+    /// that fold a triangle.
+    fn project_undisplaced(&self, s: &mut Surface, first: usize, displaced: &[bool]) {
+        let moved: Vec<(usize, Vec3)> = (first..s.positions.len())
+            .into_par_iter()
+            .filter(|&v| !displaced[v])
+            .filter_map(|v| {
+                let t = s.labels[v] as usize;
+                let leaf = self.leaf_under(t, self.uv(t, s.positions[v]))?;
+                if self.normal[leaf] == Vec3::ZERO {
+                    return None;
+                }
+                let p = self.onto_leaf(leaf, s.positions[v]);
+                (p.distance(s.positions[v]) <= self.leaf_half(leaf)).then_some((v, p))
+            })
+            .collect();
+        let mut before = Vec::with_capacity(moved.len());
+        for &(v, p) in &moved {
+            before.push((v, s.positions[v]));
+            s.positions[v] = p;
+        }
+        // Where a leaf's plane is tilted against the mesh around it the move can fold a
+        // triangle over: those moves are undone.
+        let folded = folded_vertices(s);
+        for (v, p) in before {
+            if folded.binary_search(&v).is_ok() {
+                s.positions[v] = p;
+            }
+        }
+    }
+
+    /// Half the side of leaf `leaf`'s square.
+    fn leaf_half(&self, leaf: usize) -> f32 {
+        let node = &self.tree.nodes[leaf];
+        if node.kind == NodeKind::Surface {
+            node.half
+        } else {
+            self.tree.frames[node.frame as usize].square_half
         }
     }
 

@@ -96,11 +96,6 @@ impl<'t> WindingNumber<'t> {
         }
         sum
     }
-
-    /// True where the winding number says `p` is inside.
-    pub fn inside(&self, p: Vec3) -> bool {
-        self.at(p) > 0.5
-    }
 }
 
 /// The solid angle, over 4π, of a small patch with area × normal `flux` seen from `d` away.
