@@ -9,6 +9,7 @@
 //! the link condition blocks the last collapses of a cluster (a cluster wrapped around a
 //! handle), the cluster keeps a few vertices: correct topology comes first.
 
+use super::adjacency::Rows;
 use crate::mesh::Mesh;
 use crate::tree::{NodeKind, VsTree};
 use glam::{DVec3, Vec3};
@@ -32,10 +33,10 @@ pub(crate) fn t_node_at(tree: &VsTree, p: Vec3) -> Option<u32> {
 /// cell) the label of the nearest labelled vertex along the mesh's edges.
 pub(crate) fn label_vertices(tree: &VsTree, mesh: &Mesh) -> Vec<u32> {
     let mut labels: Vec<u32> = mesh.positions.iter().map(|&p| t_node_at(tree, p).unwrap_or(UNLABELLED)).collect();
-    let neighbours = vertex_neighbours(mesh);
+    let neighbours = Rows::neighbours(&mesh.triangles, mesh.positions.len());
     let mut queue: VecDeque<u32> = (0..labels.len() as u32).filter(|&v| labels[v as usize] != UNLABELLED).collect();
     while let Some(v) = queue.pop_front() {
-        for &w in &neighbours[v as usize] {
+        for &w in neighbours.of(v) {
             if labels[w as usize] == UNLABELLED {
                 labels[w as usize] = labels[v as usize];
                 queue.push_back(w);
@@ -43,16 +44,6 @@ pub(crate) fn label_vertices(tree: &VsTree, mesh: &Mesh) -> Vec<u32> {
         }
     }
     labels
-}
-
-fn vertex_neighbours(mesh: &Mesh) -> Vec<Vec<u32>> {
-    let mut neighbours = vec![Vec::new(); mesh.positions.len()];
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            neighbours[t[k] as usize].push(t[(k + 1) % 3]);
-        }
-    }
-    neighbours
 }
 
 /// A closed surface needs at least this many vertices: a component that spans fewer T-nodes
@@ -66,18 +57,18 @@ const MIN_T_NODES_PER_COMPONENT: usize = 4;
 /// so it is not a part of the surface that the grid resolves but a bubble of the implicit
 /// function, such as the winding number leaves inside the tube of a sparsely sampled torus.
 fn stray_components(mesh: &Mesh, labels: &[u32], cell: f32) -> Vec<bool> {
-    let neighbours = vertex_neighbours(mesh);
+    let neighbours = Rows::neighbours(&mesh.triangles, mesh.positions.len());
     let mut component = vec![u32::MAX; mesh.positions.len()];
     let mut dropped = vec![false; mesh.positions.len()];
     for start in 0..mesh.positions.len() {
-        if component[start] != u32::MAX || neighbours[start].is_empty() {
+        if component[start] != u32::MAX || neighbours.of(start as u32).is_empty() {
             continue;
         }
         let mut members = vec![start as u32];
         component[start] = start as u32;
         let mut k = 0;
         while k < members.len() {
-            for &w in &neighbours[members[k] as usize] {
+            for &w in neighbours.of(members[k]) {
                 if component[w as usize] == u32::MAX {
                     component[w as usize] = start as u32;
                     members.push(w);
@@ -159,12 +150,19 @@ pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], cell: f32) -> Base
     c.finish(labels)
 }
 
+/// Ends a corner list of [`Collapser`].
+const NO_CORNER: u32 = u32::MAX;
+
 /// A triangle mesh under edge collapses: faces die, vertices merge into survivors.
 struct Collapser {
     triangles: Vec<[u32; 3]>,
     alive_face: Vec<bool>,
-    /// Faces around each vertex (dead ones are dropped lazily).
-    faces_of: Vec<Vec<u32>>,
+    /// The corners around each vertex, as linked lists: corner `3 t + k` is corner k of
+    /// triangle t; `head[v]` is v's first, `next[c]` the one after c ([`NO_CORNER`] ends a
+    /// list). Corners of dead faces are dropped lazily. Two flat arrays rather than a `Vec`
+    /// per vertex: a fraction of the memory on millions of vertices.
+    head: Vec<u32>,
+    next: Vec<u32>,
     alive_vertex: Vec<bool>,
     sum: Vec<DVec3>,
     count: Vec<u32>,
@@ -174,16 +172,19 @@ struct Collapser {
 
 impl Collapser {
     fn new(mesh: &Mesh) -> Collapser {
-        let mut faces_of = vec![Vec::new(); mesh.positions.len()];
+        let mut head = vec![NO_CORNER; mesh.positions.len()];
+        let mut next = vec![NO_CORNER; 3 * mesh.triangles.len()];
         for (t, tri) in mesh.triangles.iter().enumerate() {
-            for &v in tri {
-                faces_of[v as usize].push(t as u32);
+            for (k, &v) in tri.iter().enumerate() {
+                next[3 * t + k] = head[v as usize];
+                head[v as usize] = (3 * t + k) as u32;
             }
         }
         Collapser {
             triangles: mesh.triangles.clone(),
             alive_face: vec![true; mesh.triangles.len()],
-            faces_of,
+            head,
+            next,
             alive_vertex: vec![true; mesh.positions.len()],
             sum: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
             count: vec![1; mesh.positions.len()],
@@ -191,16 +192,27 @@ impl Collapser {
         }
     }
 
+    /// The corners around `v`, dead faces' included.
+    fn corners(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        let mut c = self.head[v as usize];
+        std::iter::from_fn(move || {
+            (c != NO_CORNER).then(|| {
+                let this = c;
+                c = self.next[c as usize];
+                this
+            })
+        })
+    }
+
+    /// The live faces around `v`.
+    fn faces(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        self.corners(v).map(|c| c / 3).filter(|&f| self.alive_face[f as usize])
+    }
+
     /// Puts the other vertices of the live faces around `v` into `ring`, sorted and unique.
     fn ring_into(&self, v: u32, ring: &mut Vec<u32>) {
         ring.clear();
-        ring.extend(
-            self.faces_of[v as usize]
-                .iter()
-                .filter(|&&f| self.alive_face[f as usize])
-                .flat_map(|&f| self.triangles[f as usize])
-                .filter(|&w| w != v),
-        );
+        ring.extend(self.faces(v).flat_map(|f| self.triangles[f as usize]).filter(|&w| w != v));
         ring.sort_unstable();
         ring.dedup();
     }
@@ -212,8 +224,8 @@ impl Collapser {
         }
         let mut shared = [0u32; 2];
         let mut shared_count = 0;
-        for &f in &self.faces_of[u as usize] {
-            if self.alive_face[f as usize] && self.triangles[f as usize].contains(&v) {
+        for f in self.faces(u) {
+            if self.triangles[f as usize].contains(&v) {
                 if shared_count == 2 {
                     return false; // more than two faces on the edge: not a manifold edge
                 }
@@ -237,18 +249,23 @@ impl Collapser {
         for &f in &shared {
             self.alive_face[f as usize] = false;
         }
-        let moved = std::mem::take(&mut self.faces_of[u as usize]);
-        for &f in &moved {
-            if self.alive_face[f as usize] {
-                for w in self.triangles[f as usize].iter_mut() {
-                    if *w == u {
-                        *w = v;
-                    }
+        // v's new list: its own live corners, then u's, now v's.
+        let mut list = NO_CORNER;
+        for x in [v, u] {
+            let mut c = self.head[x as usize];
+            while c != NO_CORNER {
+                let after = self.next[c as usize];
+                let (f, k) = ((c / 3) as usize, (c % 3) as usize);
+                if self.alive_face[f] {
+                    self.triangles[f][k] = v;
+                    self.next[c as usize] = list;
+                    list = c;
                 }
-                self.faces_of[v as usize].push(f);
+                c = after;
             }
         }
-        self.faces_of[v as usize].retain(|&f| self.alive_face[f as usize]);
+        self.head[v as usize] = list;
+        self.head[u as usize] = NO_CORNER;
         self.alive_vertex[u as usize] = false;
         let (sum, count) = (self.sum[u as usize], self.count[u as usize]);
         self.sum[v as usize] += sum;

@@ -14,6 +14,7 @@
 //! samples (at most [`ERROR_SAMPLES`] of them, evenly spread) to the mesh, over the bounding
 //! box's diagonal; the maximum is reported too.
 
+mod adjacency;
 mod base_mesh;
 mod implicit;
 mod refine;
@@ -198,12 +199,16 @@ pub fn reconstruct(
         }
     }
     // The tree's order keeps neighbours together in memory, which makes the build faster.
+    // Where error(M, S) is measured; the tree holds the samples from here on.
+    let measured = evenly_spread(&samples.positions, ERROR_SAMPLES);
+    drop(samples);
     let tree_order: Vec<Vec3> = tree.samples.iter().map(|s| s.position).collect();
     let near = threads.run(|| PointBvh::new(&tree_order));
     let spacing = sample_spacing(&near, &tree_order);
     let grid = polygonisation_grid(&tree, params.max_grid_depth, spacing);
     stats.grid_cells = grid.dims[0] - 5;
-    let seeds = sample_cells(&grid, &samples.positions, &threads);
+    let seeds = sample_cells(&grid, &tree_order, &threads);
+    drop(tree_order);
     let blend = implicit::PlaneBlend::new(&tree, SUPPORT_SCALE, 1.5 * grid.cell);
     // Distances from the samples count in grid cells, or in sample spacings where the samples
     // are sparser than the grid.
@@ -246,6 +251,7 @@ pub fn reconstruct(
     progress.report(0.4, "base mesh")?;
     let labels = base_mesh::label_vertices(&tree, &fine);
     let base = base_mesh::cluster_at_t_layer(&fine, &labels, grid.cell);
+    drop((fine, labels, seeds));
     if base.mesh.triangles.is_empty() {
         return Err(Error::input(
             "the base mesh is empty: every part of the polygonised surface was too small for the tree's T-layer",
@@ -265,8 +271,7 @@ pub fn reconstruct(
     let refiner = refine::Refiner::new(&tree, &threads);
     refiner.snap_base(&mut surface);
     refiner.unfold_base(&mut surface);
-    let measured = evenly_spread(&samples.positions, ERROR_SAMPLES);
-    let (mut rms, mut max) = sample_error(&surface, &measured, tree.diagonal, &threads);
+    let (mut rms, mut max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
     stats.base_error = rms;
     for level in 0..params.max_levels {
         if rms <= params.target_distance || 4 * surface.triangles.len() > params.max_triangles {
@@ -276,7 +281,7 @@ pub fn reconstruct(
         let (refined, level_stats) = refiner.refine(&surface, &threads);
         surface = refined;
         stats.levels.push(level_stats);
-        (rms, max) = sample_error(&surface, &measured, tree.diagonal, &threads);
+        (rms, max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
         if (level_stats.displaced as f64) < params.min_displaced * level_stats.new_vertices as f64 {
             break;
         }
@@ -350,12 +355,18 @@ fn evenly_spread(points: &[Vec3], n: usize) -> Vec<Vec3> {
 }
 
 /// error(M, S): RMS and max distance from `points` to the surface, over `diagonal`.
-fn sample_error(s: &refine::Surface, points: &[Vec3], diagonal: f32, threads: &Threads) -> (f64, f64) {
-    let mesh = Mesh { positions: s.positions.clone(), normals: None, triangles: s.triangles.clone() };
+fn sample_error(s: &mut refine::Surface, points: &[Vec3], diagonal: f32, threads: &Threads) -> (f64, f64) {
+    // The surface's arrays are lent to a mesh for the measure, not copied.
+    let mesh = Mesh {
+        positions: std::mem::take(&mut s.positions),
+        normals: None,
+        triangles: std::mem::take(&mut s.triangles),
+    };
     let distances: Vec<f64> = threads.run(|| {
         let bvh = TriangleBvh::new(&mesh);
         points.par_iter().map(|&p| f64::from(bvh.distance(p))).collect()
     });
+    (s.positions, s.triangles) = (mesh.positions, mesh.triangles);
     // Summed in order, so the figure is the same whatever the thread count.
     let (sum_sq, max) = distances.iter().fold((0.0, 0.0f64), |(s, m), &d| (s + d * d, m.max(d)));
     let d = f64::from(diagonal).max(f64::MIN_POSITIVE);

@@ -9,6 +9,7 @@
 //! interpolate their corners, so a displaced vertex stays put in later levels; the locking
 //! keeps two vertices from being pulled onto the same samples (which would alias).
 
+use super::adjacency::Rows;
 use super::base_mesh::t_node_at;
 use crate::progress::Threads;
 use crate::quadric::CellStats;
@@ -231,14 +232,14 @@ impl<'t> Refiner<'t> {
 
     /// [`Refiner::unfold_base`] for the vertices from `first` on (the others stay put).
     fn unfold(&self, s: &mut Surface, first: usize) {
-        let neighbours = vertex_neighbours(&s.triangles, s.positions.len());
+        let neighbours = Rows::neighbours(&s.triangles, s.positions.len());
         for _ in 0..UNFOLD_ROUNDS {
             let folded = folded_vertices(s);
             if folded.is_empty() {
                 return;
             }
             for v in folded.into_iter().filter(|&v| v >= first) {
-                let ring = &neighbours[v];
+                let ring = neighbours.of(v as u32);
                 if ring.is_empty() {
                     continue;
                 }
@@ -372,22 +373,6 @@ impl<'t> Refiner<'t> {
 
 /// Rounds of [`Refiner::unfold_base`].
 const UNFOLD_ROUNDS: usize = 5;
-
-/// Each vertex's neighbours along edges, sorted and unique.
-fn vertex_neighbours(triangles: &[[u32; 3]], vertices: usize) -> Vec<Vec<u32>> {
-    let mut neighbours = vec![Vec::new(); vertices];
-    for t in triangles {
-        for k in 0..3 {
-            neighbours[t[k] as usize].push(t[(k + 1) % 3]);
-            neighbours[t[(k + 1) % 3] as usize].push(t[k]);
-        }
-    }
-    for ring in &mut neighbours {
-        ring.sort_unstable();
-        ring.dedup();
-    }
-    neighbours
-}
 
 /// The corners of triangles whose normal points against the sum of their corners' normals.
 fn folded_vertices(s: &Surface) -> Vec<usize> {

@@ -1,0 +1,82 @@
+//! Who is next to whom in a triangle mesh, in two flat arrays (compressed rows): one
+//! allocation for the whole mesh, where a `Vec` per vertex costs several times the data on
+//! meshes of millions of vertices.
+
+/// Per vertex, the items around it: `items[first[v]..first[v + 1]]`.
+pub(crate) struct Rows {
+    first: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Rows {
+    /// Rows of `count` vertices from `(vertex, item)` pairs listed by `pairs` (called twice:
+    /// once to count, once to fill), each row in the order the pairs come.
+    fn build<I: Iterator<Item = (u32, u32)>>(count: usize, pairs: impl Fn() -> I) -> Rows {
+        let mut first = vec![0u32; count + 1];
+        for (v, _) in pairs() {
+            first[v as usize + 1] += 1;
+        }
+        for v in 0..count {
+            first[v + 1] += first[v];
+        }
+        let mut fill = first.clone();
+        let mut items = vec![0u32; first[count] as usize];
+        for (v, item) in pairs() {
+            items[fill[v as usize] as usize] = item;
+            fill[v as usize] += 1;
+        }
+        Rows { first, items }
+    }
+
+    /// Each vertex's neighbours along edges, sorted and unique.
+    pub fn neighbours(triangles: &[[u32; 3]], vertices: usize) -> Rows {
+        let mut rows = Rows::build(vertices, || {
+            triangles.iter().flat_map(|t| (0..3).flat_map(move |k| [(t[k], t[(k + 1) % 3]), (t[(k + 1) % 3], t[k])]))
+        });
+        rows.sort_and_dedup();
+        rows
+    }
+
+    pub fn of(&self, v: u32) -> &[u32] {
+        &self.items[self.first[v as usize] as usize..self.first[v as usize + 1] as usize]
+    }
+
+    fn sort_and_dedup(&mut self) {
+        let mut kept = 0usize;
+        let mut start = 0usize;
+        for v in 0..self.first.len() - 1 {
+            let end = self.first[v + 1] as usize;
+            let row = &mut self.items[start..end];
+            row.sort_unstable();
+            let mut unique = 0;
+            for k in 0..row.len() {
+                if k == 0 || row[k] != row[k - 1] {
+                    row[unique] = row[k];
+                    unique += 1;
+                }
+            }
+            self.items.copy_within(start..start + unique, kept);
+            self.first[v] = kept as u32;
+            kept += unique;
+            start = end;
+        }
+        *self.first.last_mut().expect("one more entry than vertices") = kept as u32;
+        self.items.truncate(kept);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_of_a_tetrahedron() {
+        let triangles = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+        let n = Rows::neighbours(&triangles, 5);
+        for v in 0..4u32 {
+            let expected: Vec<u32> = (0..4).filter(|&w| w != v).collect();
+            assert_eq!(n.of(v), expected.as_slice());
+        }
+        assert!(n.of(4).is_empty(), "an unused vertex has no neighbours");
+    }
+}
