@@ -37,6 +37,13 @@ impl Rows {
         rows
     }
 
+    /// Rows of `count` vertices from `(vertex, item)` pairs, sorted and unique.
+    pub fn from_pairs(count: usize, pairs: &[(u32, u32)]) -> Rows {
+        let mut rows = Rows::build(count, || pairs.iter().copied());
+        rows.sort_and_dedup();
+        rows
+    }
+
     pub fn of(&self, v: u32) -> &[u32] {
         &self.items[self.first[v as usize] as usize..self.first[v as usize + 1] as usize]
     }

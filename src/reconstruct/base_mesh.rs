@@ -13,6 +13,7 @@ use super::adjacency::Rows;
 use crate::mesh::Mesh;
 use crate::tree::{NodeKind, VsTree};
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 use std::collections::VecDeque;
 
 /// No T-node.
@@ -31,9 +32,8 @@ pub(crate) fn t_node_at(tree: &VsTree, p: Vec3) -> Option<u32> {
 
 /// A T-node for every vertex: the one whose cube holds it, or else (the vertex lies in an empty
 /// cell) the label of the nearest labelled vertex along the mesh's edges.
-pub(crate) fn label_vertices(tree: &VsTree, mesh: &Mesh) -> Vec<u32> {
-    let mut labels: Vec<u32> = mesh.positions.iter().map(|&p| t_node_at(tree, p).unwrap_or(UNLABELLED)).collect();
-    let neighbours = Rows::neighbours(&mesh.triangles, mesh.positions.len());
+pub(crate) fn label_vertices(tree: &VsTree, mesh: &Mesh, neighbours: &Rows) -> Vec<u32> {
+    let mut labels: Vec<u32> = mesh.positions.par_iter().map(|&p| t_node_at(tree, p).unwrap_or(UNLABELLED)).collect();
     let mut queue: VecDeque<u32> = (0..labels.len() as u32).filter(|&v| labels[v as usize] != UNLABELLED).collect();
     while let Some(v) = queue.pop_front() {
         for &w in neighbours.of(v) {
@@ -56,8 +56,7 @@ const MIN_T_NODES_PER_COMPONENT: usize = 4;
 /// neighbours', wrapped in the 14 vertices of its star. It is below the grid's resolution,
 /// so it is not a part of the surface that the grid resolves but a bubble of the implicit
 /// function, such as the winding number leaves inside the tube of a sparsely sampled torus.
-fn stray_components(mesh: &Mesh, labels: &[u32], cell: f32) -> Vec<bool> {
-    let neighbours = Rows::neighbours(&mesh.triangles, mesh.positions.len());
+fn stray_components(mesh: &Mesh, labels: &[u32], neighbours: &Rows, cell: f32) -> Vec<bool> {
     let mut component = vec![u32::MAX; mesh.positions.len()];
     let mut dropped = vec![false; mesh.positions.len()];
     for start in 0..mesh.positions.len() {
@@ -102,9 +101,10 @@ pub(crate) struct BaseMesh {
 /// Collapses every edge whose ends share a label, while the link condition allows, and places
 /// each remaining vertex at the mean of the fine vertices it absorbed. Stray components
 /// (bubbles of the implicit function, see [`stray_components`]) are dropped.
-pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], cell: f32) -> BaseMesh {
+/// `neighbours` are the fine mesh's ([`Rows::neighbours`]).
+pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], neighbours: &Rows, cell: f32) -> BaseMesh {
     let mut c = Collapser::new(fine);
-    let dropped = stray_components(fine, labels, cell);
+    let dropped = stray_components(fine, labels, neighbours, cell);
     for (t, tri) in fine.triangles.iter().enumerate() {
         if tri.iter().any(|&v| labels[v as usize] == UNLABELLED || dropped[v as usize]) {
             c.alive_face[t] = false;
@@ -314,7 +314,12 @@ mod tests {
             (crate::shapes::double_torus(), 2),
         ] {
             // Eight clusters, the octants: collapse as far as topology allows.
-            let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), 0.0);
+            let base = cluster_at_t_layer(
+                &mesh,
+                &octant_labels(&mesh),
+                &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
+                0.0,
+            );
             let r = analyze(&base.mesh);
             assert!(r.is_watertight(), "{r:?}");
             assert_eq!(r.genus(), Some(genus));
@@ -325,7 +330,12 @@ mod tests {
     #[test]
     fn components_spanning_fewer_than_four_t_nodes_are_dropped() {
         let mesh = crate::shapes::icosphere(1.0, 2);
-        let base = cluster_at_t_layer(&mesh, &vec![0; mesh.positions.len()], 0.0);
+        let base = cluster_at_t_layer(
+            &mesh,
+            &vec![0; mesh.positions.len()],
+            &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
+            0.0,
+        );
         assert!(base.mesh.positions.is_empty() && base.mesh.triangles.is_empty());
     }
 
@@ -333,7 +343,12 @@ mod tests {
     fn labels_partition_a_sphere_into_clusters() {
         let mesh = crate::shapes::icosphere(1.0, 4);
         // Eight clusters: the octants.
-        let base = cluster_at_t_layer(&mesh, &octant_labels(&mesh), 0.0);
+        let base = cluster_at_t_layer(
+            &mesh,
+            &octant_labels(&mesh),
+            &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
+            0.0,
+        );
         let r = analyze(&base.mesh);
         assert!(r.is_watertight() && r.genus() == Some(0));
         assert_eq!(base.mesh.positions.len(), 8, "one vertex per octant");

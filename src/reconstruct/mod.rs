@@ -249,9 +249,10 @@ pub fn reconstruct(
     }
     stats.fine_triangles = fine.triangles.len();
     progress.report(0.4, "base mesh")?;
-    let labels = base_mesh::label_vertices(&tree, &fine);
-    let base = base_mesh::cluster_at_t_layer(&fine, &labels, grid.cell);
-    drop((fine, labels, seeds));
+    let neighbours = adjacency::Rows::neighbours(&fine.triangles, fine.positions.len());
+    let labels = threads.run(|| base_mesh::label_vertices(&tree, &fine, &neighbours));
+    let base = base_mesh::cluster_at_t_layer(&fine, &labels, &neighbours, grid.cell);
+    drop((fine, labels, seeds, neighbours));
     if base.mesh.triangles.is_empty() {
         return Err(Error::input(
             "the base mesh is empty: every part of the polygonised surface was too small for the tree's T-layer",
@@ -281,10 +282,17 @@ pub fn reconstruct(
         let (refined, level_stats) = refiner.refine(&surface, &threads);
         surface = refined;
         stats.levels.push(level_stats);
-        (rms, max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
+        // Without a target distance only the final error is reported: no need to measure
+        // each level (a hierarchy over all the triangles each time).
+        if params.target_distance > 0.0 {
+            (rms, max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
+        }
         if (level_stats.displaced as f64) < params.min_displaced * level_stats.new_vertices as f64 {
             break;
         }
+    }
+    if params.target_distance <= 0.0 && !stats.levels.is_empty() {
+        (rms, max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
     }
     (stats.final_error, stats.final_max_error) = (rms, max);
     let t3 = Instant::now();

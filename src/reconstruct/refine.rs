@@ -232,14 +232,14 @@ impl<'t> Refiner<'t> {
 
     /// [`Refiner::unfold_base`] for the vertices from `first` on (the others stay put).
     fn unfold(&self, s: &mut Surface, first: usize) {
-        let neighbours = Rows::neighbours(&s.triangles, s.positions.len());
         for _ in 0..UNFOLD_ROUNDS {
-            let folded = folded_vertices(s);
+            let folded: Vec<usize> = folded_vertices(s).into_iter().filter(|&v| v >= first).collect();
             if folded.is_empty() {
                 return;
             }
-            for v in folded.into_iter().filter(|&v| v >= first) {
-                let ring = neighbours.of(v as u32);
+            let rings = rings_of(&s.triangles, &folded);
+            for (k, &v) in folded.iter().enumerate() {
+                let ring = rings.of(k as u32);
                 if ring.is_empty() {
                     continue;
                 }
@@ -374,17 +374,33 @@ impl<'t> Refiner<'t> {
 /// Rounds of [`Refiner::unfold_base`].
 const UNFOLD_ROUNDS: usize = 5;
 
+/// The neighbours of a few vertices (`vertices`, sorted), as rows in that order: one pass
+/// over the triangles, where all the mesh's rows would cost much more for the few needed.
+fn rings_of(triangles: &[[u32; 3]], vertices: &[usize]) -> Rows {
+    let pairs: Vec<(u32, u32)> = triangles
+        .par_iter()
+        .flat_map_iter(|t| {
+            (0..3).filter_map(move |k| {
+                let row = vertices.binary_search(&(t[k] as usize)).ok()?;
+                Some([(row as u32, t[(k + 1) % 3]), (row as u32, t[(k + 2) % 3])])
+            })
+        })
+        .flatten_iter()
+        .collect();
+    Rows::from_pairs(vertices.len(), &pairs)
+}
+
 /// The corners of triangles whose normal points against the sum of their corners' normals.
 fn folded_vertices(s: &Surface) -> Vec<usize> {
     let mut folded: Vec<usize> = s
         .triangles
-        .iter()
+        .par_iter()
         .filter(|t| {
             let [a, b, c] = t.map(|v| s.positions[v as usize]);
             let corners: Vec3 = t.iter().map(|&v| s.normals[v as usize]).sum();
             (b - a).cross(c - a).dot(corners) < 0.0
         })
-        .flat_map(|t| t.map(|v| v as usize))
+        .flat_map_iter(|t| t.map(|v| v as usize))
         .collect();
     folded.sort_unstable();
     folded.dedup();

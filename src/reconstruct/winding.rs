@@ -19,6 +19,8 @@ use glam::{Vec2, Vec3};
 
 /// A node farther than this many times its radius is summed as one dipole.
 const FAR_RATIO: f32 = 2.0;
+/// The same for a height-field leaf.
+const NEAR_LEAF_RATIO: f32 = 1.0;
 
 /// The area-weighted normals of every node's leaves, for winding-number queries.
 pub(crate) struct WindingNumber<'t> {
@@ -80,7 +82,10 @@ impl<'t> WindingNumber<'t> {
             let node = &self.tree.nodes[i];
             let d = self.centre[i] - p;
             let dist = d.length();
-            if dist > FAR_RATIO * self.radius[i] {
+            // A height-field leaf (T- or S-node) has no opposite normals to cancel: as one
+            // dipole it is accurate nearer than a node that may hold both sides of a part.
+            let far_ratio = if node.is_leaf() && node.kind != NodeKind::Volume { NEAR_LEAF_RATIO } else { FAR_RATIO };
+            if dist > far_ratio * self.radius[i] {
                 sum += dipole(self.flux[i], d);
             } else if node.is_leaf() {
                 // Close to a leaf, its samples count one by one: a leaf that holds both sides
