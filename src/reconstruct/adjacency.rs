@@ -9,29 +9,34 @@ pub(crate) struct Rows {
 }
 
 impl Rows {
-    /// Rows of `count` vertices from `(vertex, item)` pairs listed by `pairs` (called twice:
-    /// once to count, once to fill), each row in the order the pairs come.
-    fn build<I: Iterator<Item = (u32, u32)>>(count: usize, pairs: impl Fn() -> I) -> Rows {
+    /// Rows of `count` vertices from the `(vertex, item)` pairs that `visit` hands to its
+    /// argument (it is called twice: once to count, once to fill), each row in the order the
+    /// pairs come.
+    fn build(count: usize, visit: impl Fn(&mut dyn FnMut(u32, u32))) -> Rows {
         let mut first = vec![0u32; count + 1];
-        for (v, _) in pairs() {
-            first[v as usize + 1] += 1;
-        }
+        visit(&mut |v, _| first[v as usize + 1] += 1);
         for v in 0..count {
             first[v + 1] += first[v];
         }
         let mut fill = first.clone();
         let mut items = vec![0u32; first[count] as usize];
-        for (v, item) in pairs() {
+        visit(&mut |v, item| {
             items[fill[v as usize] as usize] = item;
             fill[v as usize] += 1;
-        }
+        });
         Rows { first, items }
     }
 
     /// Each vertex's neighbours along edges, sorted and unique.
     pub fn neighbours(triangles: &[[u32; 3]], vertices: usize) -> Rows {
-        let mut rows = Rows::build(vertices, || {
-            triangles.iter().flat_map(|t| (0..3).flat_map(move |k| [(t[k], t[(k + 1) % 3]), (t[(k + 1) % 3], t[k])]))
+        let mut rows = Rows::build(vertices, |pair| {
+            for t in triangles {
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    pair(a, b);
+                    pair(b, a);
+                }
+            }
         });
         rows.sort_and_dedup();
         rows
@@ -39,7 +44,11 @@ impl Rows {
 
     /// Rows of `count` vertices from `(vertex, item)` pairs, sorted and unique.
     pub fn from_pairs(count: usize, pairs: &[(u32, u32)]) -> Rows {
-        let mut rows = Rows::build(count, || pairs.iter().copied());
+        let mut rows = Rows::build(count, |pair| {
+            for &(v, item) in pairs {
+                pair(v, item);
+            }
+        });
         rows.sort_and_dedup();
         rows
     }

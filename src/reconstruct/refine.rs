@@ -379,11 +379,14 @@ const UNFOLD_ROUNDS: usize = 5;
 fn rings_of(triangles: &[[u32; 3]], vertices: &[usize]) -> Rows {
     let pairs: Vec<(u32, u32)> = triangles
         .par_iter()
-        .flat_map_iter(|t| {
-            (0..3).filter_map(move |k| {
-                let row = vertices.binary_search(&(t[k] as usize)).ok()?;
-                Some([(row as u32, t[(k + 1) % 3]), (row as u32, t[(k + 2) % 3])])
-            })
+        .fold(Vec::new, |mut pairs, t| {
+            for k in 0..3 {
+                if let Ok(row) = vertices.binary_search(&(t[k] as usize)) {
+                    pairs.push((row as u32, t[(k + 1) % 3]));
+                    pairs.push((row as u32, t[(k + 2) % 3]));
+                }
+            }
+            pairs
         })
         .flatten_iter()
         .collect();
