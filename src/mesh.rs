@@ -76,4 +76,24 @@ impl Mesh {
         }
         Ok(())
     }
+
+    /// Unit vertex normals as the area-weighted average of the incident faces' normals
+    /// (+z where undefined: unreferenced vertices, or only zero-area faces around).
+    /// Triangles with an index out of range are skipped.
+    pub fn area_weighted_normals(&self) -> Vec<Vec3> {
+        let p = &self.positions;
+        let mut sums = vec![Vec3::ZERO; p.len()];
+        for tri in &self.triangles {
+            if tri.iter().any(|&v| v as usize >= p.len()) {
+                continue;
+            }
+            let [a, b, c] = tri.map(|v| p[v as usize]);
+            // The cross product's length is twice the area: the weighting comes for free.
+            let n = (b - a).cross(c - a);
+            for &v in tri {
+                sums[v as usize] += n;
+            }
+        }
+        sums.into_iter().map(|n| n.normalize_or(Vec3::Z)).collect()
+    }
 }

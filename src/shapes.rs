@@ -139,27 +139,8 @@ pub fn bumpy_sphere(radius: f32, amplitude: f32, frequency: f32, subdivisions: u
     for p in &mut mesh.positions {
         *p *= bumpy_radius(*p, radius, amplitude, frequency);
     }
-    mesh.normals = Some(area_weighted_normals(&mesh));
+    mesh.normals = Some(mesh.area_weighted_normals());
     mesh
-}
-
-/// Unit vertex normals as the area-weighted average of the incident faces' normals
-/// (+z where undefined: unreferenced vertices, or only zero-area faces around).
-fn area_weighted_normals(mesh: &Mesh) -> Vec<Vec3> {
-    let p = &mesh.positions;
-    let mut sums = vec![Vec3::ZERO; p.len()];
-    for tri in &mesh.triangles {
-        if tri.iter().any(|&v| v as usize >= p.len()) {
-            continue;
-        }
-        let [a, b, c] = tri.map(|v| p[v as usize]);
-        // The cross product's length is twice the area: the weighting comes for free.
-        let n = (b - a).cross(c - a);
-        for &v in tri {
-            sums[v as usize] += n;
-        }
-    }
-    sums.into_iter().map(|n| n.normalize_or(Vec3::Z)).collect()
 }
 
 /// Signed distance to a torus around the z axis through `center` (exact).
@@ -401,7 +382,7 @@ pub fn implicit_mesh(f: impl Fn(Vec3) -> f32 + Sync, min: Vec3, max: Vec3, resol
         .collect();
     let mut mesh = Mesh { positions, normals: None, triangles };
     if normals.contains(&Vec3::ZERO) {
-        let fallback = area_weighted_normals(&mesh);
+        let fallback = mesh.area_weighted_normals();
         for (n, alt) in normals.iter_mut().zip(fallback) {
             if *n == Vec3::ZERO {
                 *n = alt;
