@@ -143,6 +143,25 @@ fn sorted_half_edges(faces: &[[u32; 3]]) -> Vec<HalfEdge> {
     half_edges
 }
 
+/// The genus summed over the components of a mesh that is known to be a closed 2-manifold
+/// (as the polygoniser makes it): components − χ/2, in one pass and without the checks of
+/// [`analyze`]. For any other mesh the figure means nothing.
+pub fn closed_surface_genus(mesh: &Mesh) -> i64 {
+    let mut components = UnionFind::new(mesh.positions.len());
+    let mut used = vec![false; mesh.positions.len()];
+    for t in &mesh.triangles {
+        components.union(t[0], t[1]);
+        components.union(t[1], t[2]);
+        t.iter().for_each(|&v| used[v as usize] = true);
+    }
+    let vertices = used.iter().filter(|&&u| u).count() as i64;
+    let count =
+        (0..mesh.positions.len() as u32).filter(|&v| used[v as usize] && components.find(v) == v).count() as i64;
+    // Closed: every edge has two faces, E = 3F/2, so χ = V − F/2.
+    let chi = vertices - mesh.triangles.len() as i64 / 2;
+    count - chi / 2
+}
+
 /// Computes the [`TopologyReport`] of `mesh`. Point clouds (no triangles) give a report with zero
 /// faces. Never panics on bad indices: such faces count as degenerate.
 pub fn analyze(mesh: &Mesh) -> TopologyReport {
@@ -327,6 +346,20 @@ pub fn surface_area(mesh: &Mesh) -> f64 {
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    #[test]
+    fn closed_surface_genus_agrees_with_the_full_analysis() {
+        use crate::shapes;
+        let mut two_shapes = shapes::torus(1.0, 0.3, 24, 12);
+        let double = shapes::double_torus();
+        let offset = two_shapes.positions.len() as u32;
+        two_shapes.positions.extend(double.positions.iter().map(|p| *p + Vec3::splat(5.0)));
+        two_shapes.triangles.extend(double.triangles.iter().map(|t| t.map(|v| v + offset)));
+        for (mesh, genus) in [(shapes::icosphere(1.0, 2), 0), (shapes::torus(1.0, 0.3, 24, 12), 1), (two_shapes, 3)] {
+            assert_eq!(analyze(&mesh).genus(), Some(genus as u32));
+            assert_eq!(closed_surface_genus(&mesh), genus);
+        }
+    }
 
     /// A unit tetrahedron with outward winding.
     fn tetrahedron() -> Mesh {
