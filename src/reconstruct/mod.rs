@@ -30,7 +30,7 @@ use crate::polygonize::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
 use crate::progress::{Progress, Threads};
 use crate::samples::SampleSet;
 use crate::topology;
-use crate::tree::{self, NodeKind, TreeParams, TreeStats, VsTree};
+use crate::tree::{self, NodeKind, TreeParams, TreeSample, TreeStats, VsTree};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -54,6 +54,17 @@ const OUTSIDE_BEYOND: f32 = 4.0;
 /// and ragged where the number wavers around one half; a quarter puts the closing sheet
 /// farther back, where trimming removes it. bun000: M0 genus 0 instead of 23.
 const OPEN_SCAN_INSIDE: f32 = 0.25;
+/// Where the polygonisation has handles, it is made again this many grid cells outside the
+/// zero set, and kept if that has fewer handles, with its vertices moved back by as much. The
+/// grid's points sample a part thinner than about a cell on one side only, so such a part (a
+/// bunny's ear, where overlapping scans disagree by about a cell) comes out perforated:
+/// bunny_scans_merged had 24 spurious handles, 0 thickened. Offset, the part is thick enough
+/// for the grid; moving the vertices back puts the surface where the samples are and cannot
+/// change the topology. Gaps narrower than twice the offset close, but they are below what the
+/// grid resolves faithfully anyway. Surfaces without handles are never thickened.
+const THICKEN_CELLS: f32 = 1.5;
+/// Ring averages of the fine mesh's normals before its vertices are moved back.
+const NORMAL_SMOOTHING_PASSES: usize = 2;
 /// The polygonisation gives up beyond this many grid cells along the surface.
 const MAX_GRID_CELLS: usize = 50_000_000;
 /// Fewer points than this cannot define a surface.
@@ -141,6 +152,9 @@ pub struct ReconstructStats {
     /// Cells across the polygonisation grid (a power of two).
     pub grid_cells: u32,
     pub fine_triangles: usize,
+    /// The polygonisation was thickened (see the `reconstruct` module): the plain one had
+    /// handles that vanished once parts thinner than the grid were thickened.
+    pub thickened: bool,
     pub base_vertices: usize,
     pub base_triangles: usize,
     /// Genus of M0 when it is a closed manifold.
@@ -192,12 +206,6 @@ pub fn reconstruct(
     let t1 = Instant::now();
 
     progress.report(0.35, "base mesh")?;
-    {
-        let mut h = [0usize; 16];
-        for n in tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition) {
-            h[n.depth as usize] += 1;
-        }
-    }
     // The tree's order keeps neighbours together in memory, which makes the build faster.
     // Where error(M, S) is measured; the tree holds the samples from here on.
     let measured = evenly_spread(&samples.positions, ERROR_SAMPLES);
@@ -207,7 +215,6 @@ pub fn reconstruct(
     let spacing = sample_spacing(&near, &tree_order);
     let grid = polygonisation_grid(&tree, params.max_grid_depth, spacing);
     stats.grid_cells = grid.dims[0] - 5;
-    let seeds = sample_cells(&grid, &tree_order, &threads);
     drop(tree_order);
     let blend = implicit::PlaneBlend::new(&tree, SUPPORT_SCALE, 1.5 * grid.cell);
     // Distances from the samples count in grid cells, or in sample spacings where the samples
@@ -241,7 +248,22 @@ pub fn reconstruct(
             }
         }
     };
-    let fine = track_surface(&f, &grid, &seeds, MAX_GRID_CELLS, &threads)?;
+    // Polygonised `offset` outside the zero set, from the cells the surface should cross.
+    let polygonise = |offset: f32| {
+        let seeds = sample_cells(&grid, &tree.samples, offset, &threads);
+        track_surface(&|p| f(p) - offset, &grid, &seeds, MAX_GRID_CELLS, &threads)
+    };
+    let mut fine = polygonise(0.0)?;
+    let genus = topology::closed_surface_genus(&fine);
+    if genus > 0 {
+        // Handles may be perforations of parts thinner than the grid resolves (see
+        // THICKEN_CELLS): if the thickened surface has fewer, they were.
+        let thick = polygonise(THICKEN_CELLS * grid.cell)?;
+        if !thick.triangles.is_empty() && topology::closed_surface_genus(&thick) < genus {
+            fine = thick;
+            stats.thickened = true;
+        }
+    }
     if fine.triangles.is_empty() {
         return Err(Error::input(
             "the blended T-node planes have no zero crossing near the samples (are the normals consistent?)",
@@ -250,9 +272,12 @@ pub fn reconstruct(
     stats.fine_triangles = fine.triangles.len();
     progress.report(0.4, "base mesh")?;
     let neighbours = adjacency::Rows::neighbours(&fine.triangles, fine.positions.len());
+    if stats.thickened {
+        move_inward(&mut fine, &neighbours, THICKEN_CELLS * grid.cell, &threads);
+    }
     let labels = threads.run(|| base_mesh::label_vertices(&tree, &fine, &neighbours));
     let base = base_mesh::cluster_at_t_layer(&fine, &labels, &neighbours, grid.cell);
-    drop((fine, labels, seeds, neighbours));
+    drop((fine, labels, neighbours));
     if base.mesh.triangles.is_empty() {
         return Err(Error::input(
             "the base mesh is empty: every part of the polygonised surface was too small for the tree's T-layer",
@@ -327,6 +352,29 @@ fn polygonisation_grid(tree: &VsTree, max_depth: u32, spacing: f32) -> Grid {
     Grid { origin: root.center - root.half - 2.0 * cell, cell, dims: [points; 3] }
 }
 
+/// Moves every vertex `distance` against its normal: back from the offset the polygonisation
+/// was made at onto the implicit function's zero set (near the samples the blended planes are
+/// a signed distance). A marching-tetrahedra vertex's own normal is noisy (slivers), so each
+/// normal is averaged over its ring first. Only positions change, so the topology stays.
+fn move_inward(mesh: &mut Mesh, neighbours: &adjacency::Rows, distance: f32, threads: &Threads) {
+    let mut normals = mesh.area_weighted_normals();
+    for _ in 0..NORMAL_SMOOTHING_PASSES {
+        normals = threads.run(|| {
+            (0..normals.len() as u32)
+                .into_par_iter()
+                .map(|v| {
+                    neighbours
+                        .of(v)
+                        .iter()
+                        .fold(normals[v as usize], |sum, &w| sum + normals[w as usize])
+                        .normalize_or_zero()
+                })
+                .collect()
+        });
+    }
+    threads.run(|| mesh.positions.par_iter_mut().zip(&normals).for_each(|(p, n)| *p -= distance * *n));
+}
+
 /// The median of `values` (0 when empty).
 fn median(mut values: Vec<f32>) -> f32 {
     values.sort_by(f32::total_cmp);
@@ -346,10 +394,12 @@ fn sample_spacing(near: &PointBvh, points: &[Vec3]) -> f32 {
     )
 }
 
-/// The grid cells that hold samples: where the surface tracking starts.
-fn sample_cells(grid: &Grid, positions: &[Vec3], threads: &Threads) -> Vec<[u32; 3]> {
+/// The grid cells that hold the samples moved `offset` along their normals: where the surface
+/// tracking starts (the function is polygonised that far outside the samples).
+fn sample_cells(grid: &Grid, samples: &[TreeSample], offset: f32, threads: &Threads) -> Vec<[u32; 3]> {
     threads.run(|| {
-        let mut cells: Vec<[u32; 3]> = positions.par_iter().map(|&p| grid.cell_of(p)).collect();
+        let mut cells: Vec<[u32; 3]> =
+            samples.par_iter().map(|s| grid.cell_of(s.position + offset * s.normal)).collect();
         cells.par_sort_unstable();
         cells.dedup();
         cells
