@@ -4,8 +4,11 @@
 //! 1. build the VS-Tree of the samples (the L2 bound is the de-noising control);
 //! 2. blend the T-nodes' planes into one implicit function ([`implicit`]); farther than a grid
 //!    cell or two from every sample, the samples' winding number ([`winding`]) decides inside
-//!    or outside instead; polygonise that on a grid as fine as the deepest T-node ([`crate::polygonize`]), and cluster that mesh at the
-//!    T-layer into the base mesh M0, one vertex per T-node ([`base_mesh`]);
+//!    or outside instead; polygonise that on a grid as fine as the deepest T-node
+//!    ([`crate::polygonize`]), and cluster that mesh at the T-layer into the base mesh M0, one
+//!    vertex per T-node ([`base_mesh`]). Where the polygonised surface has handles, parts
+//!    thinner than the grid resolves are thickened and the thickened surface is kept if that
+//!    removes handles (see `THICKEN_CELLS`);
 //! 3. refine: split 1-to-4 on PN triangles and displace by the quadtrees ([`refine`]), until
 //!    the mesh is close enough to the samples or the quadtrees have no detail left;
 //! 4. optionally trim faces far from every sample, so an open scan gives an open mesh.
@@ -58,7 +61,7 @@ const OPEN_SCAN_INSIDE: f32 = 0.25;
 /// zero set, and kept if that has fewer handles, with its vertices moved back by as much. The
 /// grid's points sample a part thinner than about a cell on one side only, so such a part (a
 /// bunny's ear, where overlapping scans disagree by about a cell) comes out perforated:
-/// bunny_scans_merged had 24 spurious handles, 0 thickened. Offset, the part is thick enough
+/// bunny_scans_merged has genus 24 plain and 0 thickened. Offset, the part is thick enough
 /// for the grid; moving the vertices back puts the surface where the samples are and cannot
 /// change the topology. Gaps narrower than twice the offset close, but they are below what the
 /// grid resolves faithfully anyway. Surfaces without handles are never thickened.
@@ -258,10 +261,13 @@ pub fn reconstruct(
     if genus > 0 {
         // Handles may be perforations of parts thinner than the grid resolves (see
         // THICKEN_CELLS): if the thickened surface has fewer, they were.
-        let thick = polygonise(THICKEN_CELLS * grid.cell)?;
-        if !thick.triangles.is_empty() && topology::closed_surface_genus(&thick) < genus {
-            fine = thick;
-            stats.thickened = true;
+        // A thickened surface too large for the grid budget is no reason to fail: the plain
+        // one stands.
+        if let Ok(thick) = polygonise(THICKEN_CELLS * grid.cell) {
+            if !thick.triangles.is_empty() && topology::closed_surface_genus(&thick) < genus {
+                fine = thick;
+                stats.thickened = true;
+            }
         }
     }
     if fine.triangles.is_empty() {
