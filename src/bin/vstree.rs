@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use vstree::reconstruct::{reconstruct, ReconstructParams, ReconstructStats};
+use vstree::reconstruct::{reconstruct, ReconstructParams, ReconstructStats, RefinementStop};
 use vstree::simplify::{simplify, SimplifyParams, SimplifyStats};
 use vstree::tree::{Metric, TreeKind, TreeParams, TreeStats};
 use vstree::{io, MeshSampling, Progress, SampleSet, Threads};
@@ -332,6 +332,18 @@ fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &Reconstruct
             level.displaced
         );
     }
+    let stopped = match s.stopped {
+        RefinementStop::Target => "the target distance was reached",
+        RefinementStop::NoDetail => "the quadtrees have no detail left for another level",
+        RefinementStop::MaxLevels => "the most levels (--levels) were done",
+        RefinementStop::TriangleBudget => {
+            eprintln!(
+                "warning: refinement stopped short of the target: another level would exceed the library's triangle budget"
+            );
+            "the triangle budget was reached"
+        }
+    };
+    println!("refinement stopped: {stopped}");
     println!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
     if s.trimmed_triangles > 0 {
         println!("trimmed: {} triangles far from the samples", s.trimmed_triangles);

@@ -146,6 +146,22 @@ impl ReconstructParams {
     }
 }
 
+/// Why the refinement loop ended.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RefinementStop {
+    /// error(M, S) reached `target_distance`.
+    Target,
+    /// A level displaced fewer than `min_displaced` of its new vertices: the quadtrees have
+    /// no detail left.
+    #[default]
+    NoDetail,
+    /// `max_levels` levels were done.
+    MaxLevels,
+    /// The next level would have exceeded `max_triangles`: the target asks for more triangles
+    /// than allowed (raise `max_triangles` or the target, or lower the tree's bound).
+    TriangleBudget,
+}
+
 /// What [`reconstruct`] did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ReconstructStats {
@@ -163,6 +179,8 @@ pub struct ReconstructStats {
     /// Genus of M0 when it is a closed manifold.
     pub base_genus: Option<u32>,
     pub levels: Vec<LevelStats>,
+    /// Why refinement ended.
+    pub stopped: RefinementStop,
     /// error(M, S) of M0 and of the final mesh: RMS and max sample-to-mesh distance over the
     /// diagonal.
     pub base_error: f64,
@@ -305,8 +323,14 @@ pub fn reconstruct(
     refiner.unfold_base(&mut surface);
     let (mut rms, mut max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
     stats.base_error = rms;
+    stats.stopped = RefinementStop::MaxLevels;
     for level in 0..params.max_levels {
-        if rms <= params.target_distance || 4 * surface.triangles.len() > params.max_triangles {
+        if rms <= params.target_distance {
+            stats.stopped = RefinementStop::Target;
+            break;
+        }
+        if 4 * surface.triangles.len() > params.max_triangles {
+            stats.stopped = RefinementStop::TriangleBudget;
             break;
         }
         progress.report(0.5 + 0.45 * level as f32 / params.max_levels as f32, "refining")?;
@@ -319,7 +343,11 @@ pub fn reconstruct(
             (rms, max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
         }
         if (level_stats.displaced as f64) < params.min_displaced * level_stats.new_vertices as f64 {
+            stats.stopped = RefinementStop::NoDetail;
             break;
+        }
+        if rms <= params.target_distance {
+            stats.stopped = RefinementStop::Target;
         }
     }
     if params.target_distance <= 0.0 && !stats.levels.is_empty() {
