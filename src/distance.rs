@@ -236,9 +236,21 @@ impl Bvh {
     /// `order`), with its squared distance; `None` when empty or nothing compares below
     /// infinity. Ties keep the first found.
     fn nearest(&self, p: Vec3, item_distance_squared: impl Fn(usize) -> f32) -> Option<(usize, f32)> {
+        self.search(p, item_distance_squared, f32::INFINITY, f32::NEG_INFINITY)
+    }
+
+    /// [`Bvh::nearest`] among the items closer than `below_d2` (squared), stopping at the first
+    /// item found within `enough_d2`: `None` when no item is closer than `below_d2`.
+    fn search(
+        &self,
+        p: Vec3,
+        item_distance_squared: impl Fn(usize) -> f32,
+        below_d2: f32,
+        enough_d2: f32,
+    ) -> Option<(usize, f32)> {
         let root = self.nodes.first()?;
         let mut best: Option<(usize, f32)> = None;
-        let mut best_d2 = f32::INFINITY;
+        let mut best_d2 = below_d2;
         let mut stack = [0u32; MAX_STACK];
         let mut depth = 0;
         if root.distance_squared(p) < best_d2 {
@@ -258,6 +270,9 @@ impl Bvh {
                     if d2 < best_d2 {
                         best_d2 = d2;
                         best = Some((position, d2));
+                        if d2 <= enough_d2 {
+                            return best;
+                        }
                     }
                 }
                 continue;
@@ -360,6 +375,10 @@ impl TriangleBvh {
     }
 }
 
+/// Bounded searches look a little beyond their radius, so that rounding in the squared
+/// distances cannot change an answer against the unsquared one.
+const PRUNE_MARGIN: f32 = 1.0 + 1e-4;
+
 /// A bounding volume hierarchy over a point cloud for nearest-neighbour queries.
 #[derive(Clone, Debug, Default)]
 pub struct PointBvh {
@@ -405,6 +424,28 @@ impl PointBvh {
             }
         })?;
         Some((d2.sqrt(), self.bvh.order[position]))
+    }
+
+    /// Whether the nearest point is within `radius` of `p` (`distance(p) <= radius`, to the
+    /// bit); the search stops at the first point found well inside, and skips everything
+    /// farther than `radius`, so it costs less than [`PointBvh::distance`].
+    pub fn any_within(&self, p: Vec3, radius: f32) -> bool {
+        let (below, enough) = ((radius * PRUNE_MARGIN).powi(2), (radius / PRUNE_MARGIN).powi(2));
+        let found = self.bvh.search(p, |position| self.points[position].distance_squared(p), below, enough);
+        found.is_some_and(|(_, d2)| d2.sqrt() <= radius)
+    }
+
+    /// `distance(p)` when that is at most `cap`, else `f32::INFINITY`: the search skips
+    /// everything farther than `cap`. NaN when `p` has a NaN coordinate.
+    pub fn distance_within(&self, p: Vec3, cap: f32) -> f32 {
+        if p.is_nan() {
+            return f32::NAN;
+        }
+        let below = (cap * PRUNE_MARGIN).powi(2);
+        match self.bvh.search(p, |position| self.points[position].distance_squared(p), below, f32::NEG_INFINITY) {
+            Some((_, d2)) if d2.sqrt() <= cap => d2.sqrt(),
+            _ => f32::INFINITY,
+        }
     }
 
     /// Distance from `p` to the nearest point: `f32::INFINITY` for an empty cloud, NaN when `p`
@@ -543,6 +584,22 @@ pub fn chamfer_and_hausdorff(a: &Mesh, b: &Mesh, samples_per_mesh: usize, seed: 
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn bounded_point_queries_agree_with_the_nearest_distance() {
+        let cloud = crate::shapes::sample_surface(&crate::shapes::icosphere(1.0, 3), 5_000, 2);
+        let bvh = super::PointBvh::new(&cloud.positions);
+        let mut rng = crate::rng::Rng::new(9);
+        for _ in 0..2_000 {
+            let p = glam::Vec3::new(rng.f32() * 3.0 - 1.5, rng.f32() * 3.0 - 1.5, rng.f32() * 3.0 - 1.5);
+            let d = bvh.distance(p);
+            for r in [0.01, 0.05, 0.2, d, 1.0] {
+                assert_eq!(bvh.any_within(p, r), d <= r, "{p} {r} {d}");
+                let within = bvh.distance_within(p, r);
+                assert_eq!(within, if d <= r { d } else { f32::INFINITY }, "{p} {r}");
+            }
+        }
+    }
+
     use super::*;
     use crate::rng::Rng;
     use glam::DVec3;

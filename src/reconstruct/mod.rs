@@ -247,16 +247,17 @@ pub fn reconstruct(
     let tolerance = FAR_FROM_SAMPLES * unit;
     let winding = winding::WindingNumber::new(&tree);
     let inside_above = if params.trim > 0.0 { OPEN_SCAN_INSIDE } else { 0.5 };
+    let far = OUTSIDE_BEYOND * unit.max(typical_t_half);
     let f = |p: Vec3| {
-        let d = near.distance(p);
-        if d <= tolerance {
+        if near.any_within(p, tolerance) {
             return blend.eval(p);
         }
         // Far from the samples the planes are extrapolations: the winding number says which
         // side p is on, and the function moves away from zero on that side.
         let side = if winding.at(p) > inside_above { -1.0 } else { 1.0 };
-        let blended = blend.eval(p);
-        if d > OUTSIDE_BEYOND * unit.max(typical_t_half) || blended == f32::MAX {
+        let d = near.distance_within(p, far);
+        let blended = if d <= far { blend.eval(p) } else { f32::MAX };
+        if blended == f32::MAX {
             side * f32::MAX
         } else {
             // The winding number's side wins; the planes may only push further that way.
