@@ -62,7 +62,11 @@ fn assert_closed_reconstruction(name: &str, cloud: &Mesh, genus: u32) {
     // sample's tangent plane within √e × diagonal of its cluster's point (3.2e-3 at 1e-5).
     let bound = ReconstructParams::default().tree.error.sqrt() as f32;
     // Measured at most 1.3e-3 RMS (kitten, whose scan is the noisiest) and a Chamfer of 3.0e-3.
-    assert!(stats.final_error < 0.95 * f64::from(bound), "{name}: RMS sample distance {:.2e} x diagonal", stats.final_error);
+    assert!(
+        stats.final_error < 0.95 * f64::from(bound),
+        "{name}: RMS sample distance {:.2e} x diagonal",
+        stats.final_error
+    );
     assert!(chamfer < 1.4 * bound * diagonal, "{name}: chamfer {:.2e} x diagonal", chamfer / diagonal);
     // The worst points are where displacement folds a few triangles (measured up to 2.7e-2 on
     // the double torus); the bound keeps that from getting worse.
@@ -118,9 +122,10 @@ fn merged_bunny_scans_give_a_clean_bunny() {
     assert!(report.is_watertight(), "{report:?}");
     assert_eq!(report.genus(), Some(0), "handles in the bunny");
     assert!(regular_share(&mesh) > 0.9);
-    // Measured 2.0% (3.2% before thin parts were thickened): displacement onto the leaves of
-    // misaligned overlapping scans folds some triangles.
-    assert!(folded_share(&mesh) < 0.03, "{:.2}% folded", 100.0 * folded_share(&mesh));
+    // Measured 0.86% (2.0% before folds that the leaves kept re-folding were moved along the
+    // normal only, 3.2% before thin parts were thickened): the leaves of misaligned
+    // overlapping scans disagree by more than the vertices' spacing.
+    assert!(folded_share(&mesh) < 0.015, "{:.2}% folded", 100.0 * folded_share(&mesh));
     // Measured 6.9e-4 (the zippered bunny is open underneath, where this one is closed).
     assert!(chamfer < 1e-3 * diagonal, "chamfer to bun_zipper {:.2e} x diagonal", chamfer / diagonal);
 }

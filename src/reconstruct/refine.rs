@@ -232,7 +232,7 @@ impl<'t> Refiner<'t> {
 
     /// [`Refiner::unfold_base`] for the vertices from `first` on (the others stay put).
     fn unfold(&self, s: &mut Surface, first: usize) {
-        for _ in 0..UNFOLD_ROUNDS {
+        for round in 0..2 * UNFOLD_ROUNDS {
             let folded: Vec<usize> = folded_vertices(s).into_iter().filter(|&v| v >= first).collect();
             if folded.is_empty() {
                 return;
@@ -246,8 +246,16 @@ impl<'t> Refiner<'t> {
                 let mean = ring.iter().map(|&w| s.positions[w as usize]).sum::<Vec3>() / ring.len() as f32;
                 // Back onto the surface: the leaf under the mean, in whichever T-node holds it.
                 let t = t_node_at(self.tree, mean).map_or(s.labels[v] as usize, |t| t as usize);
-                if let Some(leaf) = self.leaf_under(t, self.uv(t, mean)).filter(|&l| self.normal[l] != Vec3::ZERO) {
-                    s.positions[v] = self.place_on_leaf(leaf, mean);
+                let leaf = self.leaf_under(t, self.uv(t, mean)).filter(|&l| self.normal[l] != Vec3::ZERO);
+                if round < UNFOLD_ROUNDS {
+                    if let Some(leaf) = leaf {
+                        s.positions[v] = self.place_on_leaf(leaf, mean);
+                    }
+                } else {
+                    // Where that keeps folding (noisy leaves whose planes disagree by more than
+                    // the vertices' spacing), the mean is only moved along the leaf's normal
+                    // onto its plane: no sideways slide onto the leaf's square.
+                    s.positions[v] = leaf.map_or(mean, |leaf| self.onto_leaf(leaf, mean));
                 }
             }
         }
