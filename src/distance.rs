@@ -584,11 +584,15 @@ pub fn chamfer_and_hausdorff(a: &Mesh, b: &Mesh, samples_per_mesh: usize, seed: 
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::rng::Rng;
+    use glam::DVec3;
+
     #[test]
     fn bounded_point_queries_agree_with_the_nearest_distance() {
         let cloud = crate::shapes::sample_surface(&crate::shapes::icosphere(1.0, 3), 5_000, 2);
-        let bvh = super::PointBvh::new(&cloud.positions);
-        let mut rng = crate::rng::Rng::new(9);
+        let bvh = PointBvh::new(&cloud.positions);
+        let mut rng = Rng::new(9);
         for _ in 0..2_000 {
             let p = glam::Vec3::new(rng.f32() * 3.0 - 1.5, rng.f32() * 3.0 - 1.5, rng.f32() * 3.0 - 1.5);
             let d = bvh.distance(p);
@@ -599,10 +603,6 @@ mod tests {
             }
         }
     }
-
-    use super::*;
-    use crate::rng::Rng;
-    use glam::DVec3;
 
     /// Independent oracle: project onto the plane in double precision; if the projection is
     /// inside (barycentric test) that is the answer, else the nearest of the three edges.

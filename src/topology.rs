@@ -146,7 +146,7 @@ fn sorted_half_edges(faces: &[[u32; 3]]) -> Vec<HalfEdge> {
 /// The genus summed over the components of a mesh that is known to be a closed 2-manifold
 /// (as the polygoniser makes it): components − χ/2, in one pass and without the checks of
 /// [`analyze`]. For any other mesh the figure means nothing.
-pub fn closed_surface_genus(mesh: &Mesh) -> i64 {
+pub(crate) fn closed_surface_genus(mesh: &Mesh) -> i64 {
     let mut components = UnionFind::new(mesh.positions.len());
     let mut used = vec![false; mesh.positions.len()];
     for t in &mesh.triangles {
