@@ -42,11 +42,13 @@ impl Rows {
         rows
     }
 
-    /// Rows of `count` vertices from `(vertex, item)` pairs, sorted and unique.
-    pub fn from_pairs(count: usize, pairs: &[(u32, u32)]) -> Rows {
-        let mut rows = Rows::build(count, |pair| {
-            for &(v, item) in pairs {
-                pair(v, item);
+    /// Each vertex's triangles (indices into `triangles`), sorted and unique.
+    pub fn faces(triangles: &[[u32; 3]], vertices: usize) -> Rows {
+        let mut rows = Rows::build(vertices, |pair| {
+            for (t, tri) in triangles.iter().enumerate() {
+                for &v in tri {
+                    pair(v, t as u32);
+                }
             }
         });
         rows.sort_and_dedup();

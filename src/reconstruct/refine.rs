@@ -231,15 +231,23 @@ impl<'t> Refiner<'t> {
     }
 
     /// [`Refiner::unfold_base`] for the vertices from `first` on (the others stay put).
+    /// After one pass over all triangles, each round looks only at the triangles around the
+    /// vertices it moved: no other triangle can fold or unfold.
     fn unfold(&self, s: &mut Surface, first: usize) {
+        let mut folded: Vec<usize> = folded_vertices(s).into_iter().filter(|&v| v >= first).collect();
+        if folded.is_empty() {
+            return;
+        }
+        let faces = Rows::faces(&s.triangles, s.positions.len());
+        let mut ring = Vec::new();
         for round in 0..2 * UNFOLD_ROUNDS {
-            let folded: Vec<usize> = folded_vertices(s).into_iter().filter(|&v| v >= first).collect();
-            if folded.is_empty() {
-                return;
-            }
-            let rings = rings_of(&s.triangles, &folded);
-            for (k, &v) in folded.iter().enumerate() {
-                let ring = rings.of(k as u32);
+            for &v in &folded {
+                ring.clear();
+                for &t in faces.of(v as u32) {
+                    ring.extend(s.triangles[t as usize].iter().copied().filter(|&w| w as usize != v));
+                }
+                ring.sort_unstable();
+                ring.dedup();
                 if ring.is_empty() {
                     continue;
                 }
@@ -258,6 +266,19 @@ impl<'t> Refiner<'t> {
                     s.positions[v] = leaf.map_or(mean, |leaf| self.onto_leaf(leaf, mean));
                 }
             }
+            let mut still: Vec<usize> = folded
+                .iter()
+                .flat_map(|&v| faces.of(v as u32))
+                .filter(|&&t| is_folded(s, &s.triangles[t as usize]))
+                .flat_map(|&t| s.triangles[t as usize].map(|w| w as usize))
+                .filter(|&w| w >= first)
+                .collect();
+            still.sort_unstable();
+            still.dedup();
+            if still.is_empty() {
+                return;
+            }
+            folded = still;
         }
     }
 
@@ -382,37 +403,17 @@ impl<'t> Refiner<'t> {
 /// Rounds of [`Refiner::unfold_base`].
 const UNFOLD_ROUNDS: usize = 5;
 
-/// The neighbours of a few vertices (`vertices`, sorted), as rows in that order: one pass
-/// over the triangles, where all the mesh's rows would cost much more for the few needed.
-fn rings_of(triangles: &[[u32; 3]], vertices: &[usize]) -> Rows {
-    let pairs: Vec<(u32, u32)> = triangles
-        .par_iter()
-        .fold(Vec::new, |mut pairs, t| {
-            for k in 0..3 {
-                if let Ok(row) = vertices.binary_search(&(t[k] as usize)) {
-                    pairs.push((row as u32, t[(k + 1) % 3]));
-                    pairs.push((row as u32, t[(k + 2) % 3]));
-                }
-            }
-            pairs
-        })
-        .flatten_iter()
-        .collect();
-    Rows::from_pairs(vertices.len(), &pairs)
+/// Whether triangle `t` faces against the sum of its corners' normals.
+fn is_folded(s: &Surface, t: &[u32; 3]) -> bool {
+    let [a, b, c] = t.map(|v| s.positions[v as usize]);
+    let corners: Vec3 = t.iter().map(|&v| s.normals[v as usize]).sum();
+    (b - a).cross(c - a).dot(corners) < 0.0
 }
 
 /// The corners of triangles whose normal points against the sum of their corners' normals.
 fn folded_vertices(s: &Surface) -> Vec<usize> {
-    let mut folded: Vec<usize> = s
-        .triangles
-        .par_iter()
-        .filter(|t| {
-            let [a, b, c] = t.map(|v| s.positions[v as usize]);
-            let corners: Vec3 = t.iter().map(|&v| s.normals[v as usize]).sum();
-            (b - a).cross(c - a).dot(corners) < 0.0
-        })
-        .flat_map_iter(|t| t.map(|v| v as usize))
-        .collect();
+    let mut folded: Vec<usize> =
+        s.triangles.par_iter().filter(|t| is_folded(s, t)).flat_map_iter(|t| t.map(|v| v as usize)).collect();
     folded.sort_unstable();
     folded.dedup();
     folded
