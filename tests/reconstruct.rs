@@ -63,7 +63,7 @@ fn assert_closed_reconstruction(name: &str, cloud: &Mesh, genus: u32) {
     let bound = ReconstructParams::default().tree.error.sqrt() as f32;
     // Measured at most 1.3e-3 RMS (kitten, whose scan is the noisiest) and a Chamfer of 3.0e-3.
     assert!(
-        stats.final_error < 0.95 * f64::from(bound),
+        stats.final_error < 0.94 * f64::from(bound),
         "{name}: RMS sample distance {:.2e} x diagonal",
         stats.final_error
     );
