@@ -320,8 +320,7 @@ fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &Reconstruct
     }
     print_tree(&s.tree);
     let genus = s.base_genus.map_or("not a closed manifold".to_string(), |g| format!("genus {g}"));
-    let thickened =
-        if s.thickened { " (thickened by 1.5 cells: the plain one had handles through thin parts)" } else { "" };
+    let thickened = if s.thickened { " (thickened: the plain one had handles through thin parts)" } else { "" };
     println!("grid: {} cells across, {} triangles polygonised{thickened}", s.grid_cells, s.fine_triangles);
     println!("M0: {} vertices, {} triangles, {genus}, error {:.2e}", s.base_vertices, s.base_triangles, s.base_error);
     for (k, level) in s.levels.iter().enumerate() {

@@ -326,7 +326,8 @@ pub fn reconstruct(
     stats.base_error = rms;
     stats.stopped = RefinementStop::MaxLevels;
     for level in 0..params.max_levels {
-        if rms <= params.target_distance {
+        // M0 itself may be close enough; after a level the check below decides.
+        if level == 0 && rms <= params.target_distance {
             stats.stopped = RefinementStop::Target;
             break;
         }
@@ -343,12 +344,13 @@ pub fn reconstruct(
         if params.target_distance > 0.0 {
             (rms, max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
         }
+        if rms <= params.target_distance {
+            stats.stopped = RefinementStop::Target;
+            break;
+        }
         if (level_stats.displaced as f64) < params.min_displaced * level_stats.new_vertices as f64 {
             stats.stopped = RefinementStop::NoDetail;
             break;
-        }
-        if rms <= params.target_distance {
-            stats.stopped = RefinementStop::Target;
         }
     }
     if params.target_distance <= 0.0 && !stats.levels.is_empty() {
