@@ -123,25 +123,37 @@ struct Bvh {
 /// depend on it (nor on the thread count): only who builds which part.
 const PARALLEL_BUILD: usize = 1 << 15;
 
+/// An item being sorted into the hierarchy: its box's centre, and its index. The build moves
+/// these small records rather than indices into other arrays, so its comparisons and bounds
+/// read memory in order.
+#[derive(Clone, Copy)]
+struct Item {
+    centroid: Vec3,
+    index: u32,
+}
+
 /// What a build step needs to know about the items.
 struct BuildInput<'a> {
-    boxes: &'a [(Vec3, Vec3)],
-    centroids: &'a [Vec3],
+    /// The items' boxes, or `None` when every item is a point (its box is its centroid).
+    boxes: Option<&'a [(Vec3, Vec3)]>,
     leaf_size: usize,
 }
 
 impl BuildInput<'_> {
     /// The box of `items`, and the longest axis of their centroids' box.
-    fn bounds(&self, items: &[u32]) -> (Vec3, Vec3, usize) {
-        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    fn bounds(&self, items: &[Item]) -> (Vec3, Vec3, usize) {
         let (mut c_lo, mut c_hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        for &i in items {
-            let (bmin, bmax) = self.boxes[i as usize];
-            lo = lo.min(bmin);
-            hi = hi.max(bmax);
-            c_lo = c_lo.min(self.centroids[i as usize]);
-            c_hi = c_hi.max(self.centroids[i as usize]);
+        for item in items {
+            c_lo = c_lo.min(item.centroid);
+            c_hi = c_hi.max(item.centroid);
         }
+        let (lo, hi) = match self.boxes {
+            None => (c_lo, c_hi),
+            Some(boxes) => items.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), item| {
+                let (bmin, bmax) = boxes[item.index as usize];
+                (lo.min(bmin), hi.max(bmax))
+            }),
+        };
         let extent = c_hi - c_lo;
         let axis = if extent.x >= extent.y && extent.x >= extent.z {
             0
@@ -154,18 +166,16 @@ impl BuildInput<'_> {
     }
 
     /// Puts the lower half of `items` (by centroid along `axis`) first; returns the split.
-    fn split(&self, items: &mut [u32], axis: usize) -> usize {
+    fn split(&self, items: &mut [Item], axis: usize) -> usize {
         let middle = items.len() / 2;
-        items.select_nth_unstable_by(middle, |&a, &b| {
-            self.centroids[a as usize][axis].total_cmp(&self.centroids[b as usize][axis])
-        });
+        items.select_nth_unstable_by(middle, |a, b| a.centroid[axis].total_cmp(&b.centroid[axis]));
         middle
     }
 
     /// The nodes of the subtree over `items`, which sit at position `offset` of the full order.
     /// The root comes first and the two children of a node are adjacent. Leaves' `first` is a
     /// position in the full order; internal nodes' `first` indexes the returned vector.
-    fn subtree(&self, items: &mut [u32], offset: usize) -> Vec<Node> {
+    fn subtree(&self, items: &mut [Item], offset: usize) -> Vec<Node> {
         if items.len() <= PARALLEL_BUILD {
             return self.sequential_subtree(items, offset);
         }
@@ -189,7 +199,7 @@ impl BuildInput<'_> {
     }
 
     /// [`BuildInput::subtree`] on one thread, with an explicit stack.
-    fn sequential_subtree(&self, items: &mut [u32], offset: usize) -> Vec<Node> {
+    fn sequential_subtree(&self, items: &mut [Item], offset: usize) -> Vec<Node> {
         let blank = Node { min: Vec3::ZERO, max: Vec3::ZERO, first: 0, count: 0 };
         // A median split halves the count, so there are fewer than 4 n / leaf_size nodes.
         let mut nodes = Vec::with_capacity(4 * items.len() / self.leaf_size + 1);
@@ -221,15 +231,24 @@ impl Bvh {
     /// items per leaf: top-down, each node split at the median centroid along the longest axis
     /// of its centroids' box.
     fn build(boxes: &[(Vec3, Vec3)], leaf_size: usize) -> Bvh {
-        let n = boxes.len();
-        if n == 0 {
+        let items =
+            boxes.par_iter().enumerate().map(|(i, (lo, hi))| Item { centroid: (*lo + *hi) * 0.5, index: i as u32 });
+        Bvh::build_from(items.collect(), Some(boxes), leaf_size)
+    }
+
+    /// [`Bvh::build`] over points (each its own box).
+    fn build_over_points(points: &[Vec3], leaf_size: usize) -> Bvh {
+        let items = points.par_iter().enumerate().map(|(i, &p)| Item { centroid: p, index: i as u32 });
+        Bvh::build_from(items.collect(), None, leaf_size)
+    }
+
+    fn build_from(mut items: Vec<Item>, boxes: Option<&[(Vec3, Vec3)]>, leaf_size: usize) -> Bvh {
+        if items.is_empty() {
             return Bvh::default();
         }
-        let centroids: Vec<Vec3> = boxes.par_iter().map(|(lo, hi)| (*lo + *hi) * 0.5).collect();
-        let mut order: Vec<u32> = (0..n as u32).collect();
-        let input = BuildInput { boxes, centroids: &centroids, leaf_size: leaf_size.max(1) };
-        let nodes = input.subtree(&mut order, 0);
-        Bvh { nodes, order }
+        let input = BuildInput { boxes, leaf_size: leaf_size.max(1) };
+        let nodes = input.subtree(&mut items, 0);
+        Bvh { nodes, order: items.iter().map(|item| item.index).collect() }
     }
 
     /// The item minimising `item_distance_squared(position, p)` over positions (indices into
@@ -390,8 +409,7 @@ pub struct PointBvh {
 impl PointBvh {
     /// Builds the hierarchy over `points`.
     pub fn new(points: &[Vec3]) -> PointBvh {
-        let boxes: Vec<(Vec3, Vec3)> = points.par_iter().map(|&p| (p, p)).collect();
-        let bvh = Bvh::build(&boxes, POINT_LEAF);
+        let bvh = Bvh::build_over_points(points, POINT_LEAF);
         let sorted = bvh.order.iter().map(|&i| points[i as usize]).collect();
         PointBvh { bvh, points: sorted }
     }

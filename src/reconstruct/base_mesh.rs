@@ -166,8 +166,10 @@ struct Collapser {
     alive_vertex: Vec<bool>,
     sum: Vec<DVec3>,
     count: Vec<u32>,
-    /// Scratch space for the two rings of the link test.
-    rings: (Vec<u32>, Vec<u32>),
+    /// Scratch marks of the link test: a vertex marked `stamp` is in the first ring, one
+    /// marked `stamp + 1` has been seen in the second. Older marks mean "not seen".
+    mark: Vec<u32>,
+    stamp: u32,
 }
 
 impl Collapser {
@@ -188,7 +190,8 @@ impl Collapser {
             alive_vertex: vec![true; mesh.positions.len()],
             sum: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
             count: vec![1; mesh.positions.len()],
-            rings: Default::default(),
+            mark: vec![0; mesh.positions.len()],
+            stamp: 1,
         }
     }
 
@@ -209,12 +212,40 @@ impl Collapser {
         self.corners(v).map(|c| c / 3).filter(|&f| self.alive_face[f as usize])
     }
 
-    /// Puts the other vertices of the live faces around `v` into `ring`, sorted and unique.
-    fn ring_into(&self, v: u32, ring: &mut Vec<u32>) {
-        ring.clear();
-        ring.extend(self.faces(v).flat_map(|f| self.triangles[f as usize]).filter(|&w| w != v));
-        ring.sort_unstable();
-        ring.dedup();
+    /// The link test of edge u-v, with marks instead of sorted rings: the sizes of the two
+    /// rings (the other vertices of the live faces around `u`, and around `v`) and how many
+    /// vertices they share.
+    fn rings_and_common(&mut self, u: u32, v: u32) -> (usize, usize, usize) {
+        if self.stamp >= u32::MAX - 2 {
+            self.mark.fill(0);
+            self.stamp = 1;
+        }
+        self.stamp += 2;
+        let (first, seen) = (self.stamp, self.stamp + 1);
+        let mut mark = std::mem::take(&mut self.mark);
+        let mut ring_u = 0;
+        for f in self.faces(u) {
+            for w in self.triangles[f as usize] {
+                if w != u && mark[w as usize] != first {
+                    mark[w as usize] = first;
+                    ring_u += 1;
+                }
+            }
+        }
+        let (mut ring_v, mut common) = (0, 0);
+        for f in self.faces(v) {
+            for w in self.triangles[f as usize] {
+                let m = &mut mark[w as usize];
+                if w == v || *m == seen {
+                    continue;
+                }
+                common += usize::from(*m == first);
+                ring_v += 1;
+                *m = seen;
+            }
+        }
+        self.mark = mark;
+        (ring_u, ring_v, common)
     }
 
     /// Merges `u` into `v` if the edge exists and the link condition holds.
@@ -236,14 +267,9 @@ impl Collapser {
         if shared_count != 2 {
             return false; // not an edge of a closed manifold (or no edge at all)
         }
-        let (mut ring_u, mut ring_v) = std::mem::take(&mut self.rings);
-        self.ring_into(u, &mut ring_u);
-        self.ring_into(v, &mut ring_v);
-        let common = ring_u.iter().filter(|w| ring_v.binary_search(w).is_ok()).count();
+        let (ring_u, ring_v, common) = self.rings_and_common(u, v);
         // Link condition; and never shrink a closed component below a tetrahedron.
-        let allowed = common == 2 && ring_u.len() + ring_v.len() > 6;
-        self.rings = (ring_u, ring_v);
-        if !allowed {
+        if common != 2 || ring_u + ring_v <= 6 {
             return false;
         }
         for &f in &shared {

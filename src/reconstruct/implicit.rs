@@ -14,7 +14,7 @@
 //! part no support reaches. So away from the samples the caller lets the winding number
 //! decide the side (see `reconstruct` and `winding`).
 
-use crate::tree::{NodeKind, VsTree};
+use crate::tree::{NodeKind, VsTree, MAX_DEPTH};
 use glam::Vec3;
 
 /// The blended signed distance to the T-layer's planes.
@@ -63,8 +63,12 @@ impl<'t> PlaneBlend<'t> {
     /// The blended function at `p`: negative inside, positive outside.
     pub fn eval(&self, p: Vec3) -> f32 {
         let (mut sum, mut weights) = (0.0f32, 0.0f32);
-        let mut stack = vec![0usize];
-        while let Some(i) = stack.pop() {
+        // Depth-first, at most eight children pushed per level: a fixed stack, no allocation.
+        let mut stack = [0u32; 8 * (MAX_DEPTH as usize + 1)];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let i = stack[top] as usize;
             if (p.cmplt(self.reach_lo[i]) | p.cmpgt(self.reach_hi[i])).any() {
                 continue;
             }
@@ -78,7 +82,12 @@ impl<'t> PlaneBlend<'t> {
                         weights += w;
                     }
                 }
-                NodeKind::Volume => stack.extend(node.children()),
+                NodeKind::Volume => {
+                    for c in node.children() {
+                        stack[top] = c as u32;
+                        top += 1;
+                    }
+                }
                 NodeKind::Surface => {}
             }
         }
