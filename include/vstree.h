@@ -75,7 +75,7 @@
 /**
  * Patch version (semver).
  */
-#define VSTREE_VERSION_PATCH 0
+#define VSTREE_VERSION_PATCH 1
 
 /**
  * The ABI version: the number in the shared library's SONAME (`libvstree.so.0`). It changes
@@ -108,6 +108,27 @@
  * shapes of any genus come out outward; an open scan faces its convex side). The default.
  */
 #define VSTREE_ORIENTATION_PROPAGATE_OUTWARD 3
+
+/**
+ * `stopped` value: error(M, S) reached `target_distance`.
+ */
+#define VSTREE_REFINEMENT_STOPPED_TARGET 0
+
+/**
+ * `stopped` value: a level displaced fewer than `min_displaced` of its new vertices (the tree's
+ * quadtrees have no detail left).
+ */
+#define VSTREE_REFINEMENT_STOPPED_NO_DETAIL 1
+
+/**
+ * `stopped` value: `max_levels` levels were done.
+ */
+#define VSTREE_REFINEMENT_STOPPED_MAX_LEVELS 2
+
+/**
+ * `stopped` value: the next level would have exceeded `max_triangles`; raise it or the target.
+ */
+#define VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET 3
 
 /**
  * The outcome of every fallible call. The numbers are part of the ABI: they never change and
@@ -998,6 +1019,15 @@ typedef struct vstree_reconstruct_stats {
    * Seconds in the whole library call, from parameter check to result.
    */
   double seconds_total;
+  /**
+   * Why refinement stopped: one of the VSTREE_REFINEMENT_STOPPED_ values. Since 0.1.1.
+   */
+  uint32_t stopped;
+  /**
+   * 1 when the base mesh was polygonised with thin parts thickened (the plain
+   * polygonisation had handles and the thickened one fewer), else 0. Since 0.1.1.
+   */
+  uint32_t thickened;
 } vstree_reconstruct_stats;
 
 #ifdef __cplusplus

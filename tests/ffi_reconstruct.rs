@@ -10,7 +10,7 @@ use vstree::ffi::normals::*;
 use vstree::ffi::reconstruct::*;
 use vstree::ffi::*;
 use vstree::normals::{ensure_normals, NormalParams, Orientation};
-use vstree::reconstruct::{reconstruct, ReconstructParams};
+use vstree::reconstruct::{reconstruct, ReconstructParams, RefinementStop};
 use vstree::{shapes, topology, Mesh, Progress};
 
 mod common;
@@ -62,6 +62,14 @@ fn reconstruct_through_the_abi_equals_the_rust_call() {
         assert_eq!(stats.normals_estimated as usize, if with_normals { 0 } else { cloud.positions.len() });
         assert!(stats.final_max_error >= stats.final_error && stats.final_error < 1e-2);
         assert!(stats.seconds_total >= stats.seconds_tree);
+        assert_eq!(stats.thickened, u32::from(s.thickened));
+        let stop = [
+            (RefinementStop::Target, VSTREE_REFINEMENT_STOPPED_TARGET),
+            (RefinementStop::NoDetail, VSTREE_REFINEMENT_STOPPED_NO_DETAIL),
+            (RefinementStop::MaxLevels, VSTREE_REFINEMENT_STOPPED_MAX_LEVELS),
+            (RefinementStop::TriangleBudget, VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET),
+        ];
+        assert!(stop.contains(&(s.stopped, stats.stopped)), "{:?} vs {}", s.stopped, stats.stopped);
         assert_eq!(topology::analyze(&out).genus(), Some(1));
 
         // take_mesh moves the same mesh out and frees the result.

@@ -7,7 +7,7 @@ use super::params::{self, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::{guard, guard_or, non_null, vstree_status, write_out, FfiResult};
 use crate::normals::NormalParams;
-use crate::reconstruct::{reconstruct, ReconstructParams, ReconstructStats};
+use crate::reconstruct::{reconstruct, ReconstructParams, ReconstructStats, RefinementStop};
 use crate::tree::{Metric, TreeKind, TreeParams};
 use std::ffi::c_void;
 use std::mem::size_of;
@@ -200,6 +200,31 @@ pub struct vstree_reconstruct_stats {
     pub seconds_trim: f64,
     /// Seconds in the whole library call, from parameter check to result.
     pub seconds_total: f64,
+    /// Why refinement stopped: one of the VSTREE_REFINEMENT_STOPPED_ values. Since 0.1.1.
+    pub stopped: u32,
+    /// 1 when the base mesh was polygonised with thin parts thickened (the plain
+    /// polygonisation had handles and the thickened one fewer), else 0. Since 0.1.1.
+    pub thickened: u32,
+}
+
+/// `stopped` value: error(M, S) reached `target_distance`.
+pub const VSTREE_REFINEMENT_STOPPED_TARGET: u32 = 0;
+/// `stopped` value: a level displaced fewer than `min_displaced` of its new vertices (the tree's
+/// quadtrees have no detail left).
+pub const VSTREE_REFINEMENT_STOPPED_NO_DETAIL: u32 = 1;
+/// `stopped` value: `max_levels` levels were done.
+pub const VSTREE_REFINEMENT_STOPPED_MAX_LEVELS: u32 = 2;
+/// `stopped` value: the next level would have exceeded `max_triangles`; raise it or the target.
+pub const VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET: u32 = 3;
+
+/// The C value of a refinement stop.
+fn stopped_value(stop: RefinementStop) -> u32 {
+    match stop {
+        RefinementStop::Target => VSTREE_REFINEMENT_STOPPED_TARGET,
+        RefinementStop::NoDetail => VSTREE_REFINEMENT_STOPPED_NO_DETAIL,
+        RefinementStop::MaxLevels => VSTREE_REFINEMENT_STOPPED_MAX_LEVELS,
+        RefinementStop::TriangleBudget => VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET,
+    }
 }
 
 /// The C statistics of a reconstruction of `input_points` points.
@@ -232,6 +257,8 @@ pub(crate) fn stats_of(s: &ReconstructStats, input_points: usize, seconds_total:
         seconds_refine: s.seconds_refine,
         seconds_trim: s.seconds_trim,
         seconds_total,
+        stopped: stopped_value(s.stopped),
+        thickened: u32::from(s.thickened),
     }
 }
 

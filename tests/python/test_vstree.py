@@ -308,6 +308,9 @@ def test_reconstruct_a_sphere_from_numpy_points():
     assert s["input_points"] == len(points) and s["normals_estimated"] == len(points)
     assert s["base_genus"] == 0 and euler_genus(mesh) == (0, True)
     assert 0 < s["final_error"] <= s["final_max_error"] < 0.05
+    # A sphere has no handles to thicken; two levels asked, two done, unless detail ran out.
+    assert s["thickened"] is False
+    assert s["stopped"] == ("max_levels" if s["levels"] == 2 else "no_detail"), s
     radii = np.linalg.norm(mesh.positions, axis=1)
     assert np.all(np.abs(radii - 1) < 0.05), (radii.min(), radii.max())
     # Outward normals; triangles counter-clockwise seen from outside (all but the few that

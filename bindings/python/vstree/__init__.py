@@ -486,7 +486,9 @@ def reconstruct(cloud, normals=None, progress=None, **params):
 
     ``progress(fraction, stage)`` is called on this thread; returning False cancels
     (:class:`CancelledError`). Returns ``ReconstructResult(mesh, stats)``; ``stats["base_genus"]``
-    is -1 when the base mesh is not a closed manifold.
+    is -1 when the base mesh is not a closed manifold; ``stats["stopped"]`` says why refinement
+    stopped ("target" | "no_detail" | "max_levels" | "triangle_budget"), and
+    ``stats["thickened"]`` whether thin parts were thickened for the base mesh.
     """
     mesh = _cloud(cloud, normals)
     p = lib.vstree_reconstruct_params_default()
@@ -500,6 +502,8 @@ def reconstruct(cloud, normals=None, progress=None, **params):
         if stats.struct_size < ctypes.sizeof(_ffi.ReconstructStats):
             raise VstreeError(Status.INTERNAL, "the library's statistics are older than this module")
         stats = _struct_dict(stats)
+        stats["stopped"] = _ffi.REFINEMENT_STOPPED.get(stats["stopped"], "unknown")
+        stats["thickened"] = bool(stats["thickened"])
     except BaseException:
         lib.vstree_reconstruct_result_free(result)
         raise

@@ -244,7 +244,13 @@ class ReconstructStats(Structure):
         ("seconds_refine", c_double),
         ("seconds_trim", c_double),
         ("seconds_total", c_double),
+        ("stopped", c_uint32),
+        ("thickened", c_uint32),
     ]
+
+
+# Why refinement stopped (ReconstructStats.stopped), as the Python API names it.
+REFINEMENT_STOPPED = {0: "target", 1: "no_detail", 2: "max_levels", 3: "triangle_budget"}
 
 
 # ---- functions ------------------------------------------------------------------------------
