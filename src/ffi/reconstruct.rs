@@ -380,7 +380,8 @@ mod tests {
         assert_eq!(offset_of!(vstree_reconstruct_params, min_cell_size), 32);
         assert_eq!(offset_of!(vstree_reconstruct_params, max_triangles), 56);
         assert_eq!(offset_of!(vstree_reconstruct_params, threads), 76);
-        assert_eq!(size_of::<vstree_reconstruct_stats>(), 24 + 21 * 8);
+        assert_eq!(size_of::<vstree_reconstruct_stats>(), 24 + 21 * 8 + 8);
+        assert_eq!(offset_of!(vstree_reconstruct_stats, stopped), 24 + 21 * 8);
     }
 
     #[test]

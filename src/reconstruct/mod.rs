@@ -20,6 +20,7 @@
 mod adjacency;
 mod base_mesh;
 mod implicit;
+mod leaf_fit;
 mod refine;
 mod winding;
 
