@@ -124,38 +124,28 @@ struct Bvh {
 /// depend on it (nor on the thread count): only who builds which part.
 const PARALLEL_BUILD: usize = 1 << 15;
 
-/// An item being sorted into the hierarchy: its box's centre, and its index. The build moves
-/// these small records rather than indices into other arrays, so its comparisons and bounds
-/// read memory in order.
+/// A point being sorted into the hierarchy, and its index. The build moves these small records
+/// rather than indices into another array, so its comparisons and bounds read memory in order.
 #[derive(Clone, Copy)]
 struct Item {
     centroid: Vec3,
     index: u32,
 }
 
-/// What a build step needs to know about the items.
-struct BuildInput<'a> {
-    /// The items' boxes, or `None` when every item is a point (its box is its centroid).
-    boxes: Option<&'a [(Vec3, Vec3)]>,
+/// What a build step of the median-split hierarchy (over points) needs to know.
+struct BuildInput {
     leaf_size: usize,
 }
 
-impl BuildInput<'_> {
-    /// The box of `items`, and the longest axis of their centroids' box.
+impl BuildInput {
+    /// The box of `items`, and its longest axis.
     fn bounds(&self, items: &[Item]) -> (Vec3, Vec3, usize) {
-        let (mut c_lo, mut c_hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         for item in items {
-            c_lo = c_lo.min(item.centroid);
-            c_hi = c_hi.max(item.centroid);
+            lo = lo.min(item.centroid);
+            hi = hi.max(item.centroid);
         }
-        let (lo, hi) = match self.boxes {
-            None => (c_lo, c_hi),
-            Some(boxes) => items.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), item| {
-                let (bmin, bmax) = boxes[item.index as usize];
-                (lo.min(bmin), hi.max(bmax))
-            }),
-        };
-        let extent = c_hi - c_lo;
+        let extent = hi - lo;
         let axis = if extent.x >= extent.y && extent.x >= extent.z {
             0
         } else if extent.y >= extent.z {
@@ -329,19 +319,10 @@ fn join_subtrees(root: Node, left: Vec<Node>, right: Vec<Node>) -> Vec<Node> {
 
 impl Bvh {
     /// Builds the hierarchy over items with boxes `boxes[i] = (min, max)`, at most `leaf_size`
-    /// items per leaf: top-down, each node split at the median centroid along the longest axis
-    /// of its centroids' box. Only the tests build it over boxes: points are built the same way
-    /// by [`Bvh::build_over_points`], triangles by [`Bvh::build_morton`].
-    #[cfg(test)]
-    fn build(boxes: &[(Vec3, Vec3)], leaf_size: usize) -> Bvh {
-        let items =
-            boxes.par_iter().enumerate().map(|(i, (lo, hi))| Item { centroid: (*lo + *hi) * 0.5, index: i as u32 });
-        Bvh::build_from(items.collect(), Some(boxes), leaf_size)
-    }
-
-    /// Like [`Bvh::build`], but faster to build and a little slower to search: the items are
-    /// sorted along a Morton curve and each node is split where its codes' common prefix ends
-    /// (a linear BVH, Lauterbach et al. 2009). For hierarchies searched a few times per item.
+    /// items per leaf: the items are sorted along a Morton curve and each node is split where
+    /// its codes' common prefix ends (a linear BVH, Lauterbach et al. 2009). Fast to build, a
+    /// little slower to search than [`Bvh::build_over_points`]'s median splits: for
+    /// hierarchies searched a few times per item.
     fn build_morton(boxes: &[(Vec3, Vec3)], leaf_size: usize) -> Bvh {
         if boxes.is_empty() {
             return Bvh::default();
@@ -351,18 +332,16 @@ impl Bvh {
         Bvh { nodes, order: items.iter().map(|&(_, i)| i).collect() }
     }
 
-    /// [`Bvh::build`] over points (each its own box).
+    /// Builds the hierarchy over points (each its own box), at most `leaf_size` per leaf:
+    /// top-down, each node split at the median along the longest axis of its box. Slower to
+    /// build than [`Bvh::build_morton`], faster to search: for the many queries of a cloud.
     fn build_over_points(points: &[Vec3], leaf_size: usize) -> Bvh {
-        let items = points.par_iter().enumerate().map(|(i, &p)| Item { centroid: p, index: i as u32 });
-        Bvh::build_from(items.collect(), None, leaf_size)
-    }
-
-    fn build_from(mut items: Vec<Item>, boxes: Option<&[(Vec3, Vec3)]>, leaf_size: usize) -> Bvh {
-        if items.is_empty() {
+        if points.is_empty() {
             return Bvh::default();
         }
-        let input = BuildInput { boxes, leaf_size: leaf_size.max(1) };
-        let nodes = input.subtree(&mut items, 0);
+        let mut items: Vec<Item> =
+            points.par_iter().enumerate().map(|(i, &p)| Item { centroid: p, index: i as u32 }).collect();
+        let nodes = BuildInput { leaf_size: leaf_size.max(1) }.subtree(&mut items, 0);
         Bvh { nodes, order: items.iter().map(|item| item.index).collect() }
     }
 
@@ -859,20 +838,21 @@ mod tests {
                 (p, p + Vec3::splat(rng.f32() * 0.01))
             })
             .collect();
+        let points: Vec<Vec3> = boxes.iter().map(|b| b.0).collect();
+        let point_boxes: Vec<(Vec3, Vec3)> = points.iter().map(|&p| (p, p)).collect();
         for morton in [false, true] {
             let build = |threads| {
                 let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-                pool.install(|| if morton { Bvh::build_morton(&boxes, 4) } else { Bvh::build(&boxes, 4) })
+                pool.install(|| if morton { Bvh::build_morton(&boxes, 4) } else { Bvh::build_over_points(&points, 4) })
             };
             let (one, two) = (build(1), build(2));
-            validate(&two, &boxes, 4);
+            validate(&two, if morton { &boxes } else { &point_boxes }, 4);
             assert_eq!(one.order, two.order);
             assert_eq!(format!("{:?}", one.nodes), format!("{:?}", two.nodes));
         }
         // Many equal centres (duplicated triangles): split in the middle, still valid.
         let repeated: Vec<(Vec3, Vec3)> = boxes.iter().take(100).cycle().take(3 * PARALLEL_BUILD).copied().collect();
         validate(&Bvh::build_morton(&repeated, 4), &repeated, 4);
-        let points: Vec<Vec3> = boxes.iter().map(|b| b.0).collect();
         let cloud = PointBvh::new(&points);
         for q in points.iter().step_by(997) {
             assert_eq!(cloud.distance(*q), 0.0);
