@@ -39,8 +39,13 @@ usage: cargo bench --bench table1 -- [options]
   --data DIR         data directory (default ../shared/data, relative to the project root)
   --threads N        worker threads, 0 = all cores (default 0)
   --peer-runs N      timed runs of each peer (default 3)
+  --sweep N          clusters of both trees over a range of bounds, on N samples drawn on a
+                     sphere and on the cloud surface (default 1000000; or none)
   --no-memory        skip the peak-memory measurement
   --no-write         print the report only, do not update docs/benchmarks.md";
+
+/// Bounds of the sweep: three decades each side of the table's, in half-decade steps.
+const SWEEP_BOUNDS: [f64; 11] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7];
 
 /// Command-line options.
 struct Options {
@@ -53,6 +58,7 @@ struct Options {
     data: PathBuf,
     threads: usize,
     peer_runs: usize,
+    sweep: Option<usize>,
     memory: bool,
     write: bool,
 }
@@ -69,6 +75,7 @@ impl Options {
             data: root.join("../shared/data"),
             threads: 0,
             peer_runs: 3,
+            sweep: Some(1_000_000),
             memory: true,
             write: true,
         };
@@ -88,6 +95,10 @@ impl Options {
                     o.big = if v == "none" { Vec::new() } else { list(v)? };
                 }
                 "--bounds" => o.bounds = list(value()?)?,
+                "--sweep" => {
+                    let v = value()?;
+                    o.sweep = if v == "none" { None } else { Some(number(v)?) };
+                }
                 "--models" => o.models = Some(names(value()?)),
                 "--data" => o.data = PathBuf::from(value()?),
                 other => return Err(format!("unknown option {other}\n{USAGE}")),
@@ -194,6 +205,15 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
             }
         }
     }
+    let mut sweep = Vec::new();
+    if let Some(count) = o.sweep {
+        let sphere = vstree::shapes::icosphere(1.0, 6);
+        for (name, mesh) in [("sphere", &sphere), (surface_name.as_str(), &surface)] {
+            let name = format!("{name} {}", common::inputs::short_count(count));
+            eprintln!("table1: bound sweep on {name}");
+            sweep.extend(measure::sweep(&name, &inputs::cloud(mesh, count), &SWEEP_BOUNDS, &threads)?);
+        }
+    }
     drop(surface);
 
     let mut memory = Vec::new();
@@ -212,6 +232,7 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
     Ok(Report {
         rows,
         one_thread,
+        sweep,
         methods,
         memory,
         context: Context {

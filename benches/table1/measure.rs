@@ -24,6 +24,9 @@ pub struct Build {
     pub stats: TreeStats,
     /// Leaves that are S-nodes: clusters cut by a quadtree in a T-node's plane.
     pub surface_leaves: usize,
+    /// Leaves plus the empty cells a pointer-based tree allocates (8 children per octree split,
+    /// 4 per quadtree split, empty or not): what the paper's Table 1 calls "partitions".
+    pub partitions: usize,
 }
 
 impl Build {
@@ -38,10 +41,25 @@ impl Build {
     }
 }
 
-/// The tree's figures, and how many of its leaves are S-nodes.
-fn figures(tree: &VsTree) -> (TreeStats, usize) {
-    let surface = tree.nodes.iter().filter(|n| n.is_leaf() && n.kind == NodeKind::Surface).count();
-    (tree.stats(), surface)
+/// A tree's figures beyond [`TreeStats`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Figures {
+    pub stats: TreeStats,
+    pub surface_leaves: usize,
+    pub partitions: usize,
+}
+
+/// The tree's figures: its stats, how many leaves are S-nodes, and its partitions.
+pub fn figures(tree: &VsTree) -> Figures {
+    let surface_leaves = tree.nodes.iter().filter(|n| n.is_leaf() && n.kind == NodeKind::Surface).count();
+    let empty: usize = tree
+        .nodes
+        .iter()
+        .filter(|n| !n.is_leaf())
+        .map(|n| if n.kind == NodeKind::Volume { 8 } else { 4 } - usize::from(n.child_count))
+        .sum();
+    let stats = tree.stats();
+    Figures { stats, surface_leaves, partitions: stats.leaves + empty }
 }
 
 /// A timed sample should last at least this long: faster builds are repeated within one sample
@@ -60,11 +78,11 @@ pub fn builds(
     warm_up: bool,
 ) -> vstree::Result<[Build; 2]> {
     let mut times = [Vec::new(), Vec::new()];
-    let mut stats = [(TreeStats::default(), 0); 2];
+    let mut stats = [Figures::default(); 2];
     // Mean seconds of `repeat` builds of kind `k`, and the tree's figures.
-    let build = |k: usize, repeat: usize| -> vstree::Result<(f64, (TreeStats, usize))> {
+    let build = |k: usize, repeat: usize| -> vstree::Result<(f64, Figures)> {
         let mut total = 0.0;
-        let mut last = (TreeStats::default(), 0);
+        let mut last = Figures::default();
         for _ in 0..repeat {
             let start = Instant::now();
             let tree = tree::build(samples, &params(KINDS[k], bound), threads, &mut Progress::none())?;
@@ -88,7 +106,12 @@ pub fn builds(
             stats[k] = s;
         }
     }
-    Ok([0, 1].map(|k| Build { seconds: median(&times[k]), stats: stats[k].0, surface_leaves: stats[k].1 }))
+    Ok([0, 1].map(|k| Build {
+        seconds: median(&times[k]),
+        stats: stats[k].stats,
+        surface_leaves: stats[k].surface_leaves,
+        partitions: stats[k].partitions,
+    }))
 }
 
 /// A simplified mesh and the median time it took.
@@ -116,4 +139,33 @@ pub fn simplified(mesh: &Mesh, kind: TreeKind, bound: f64, threads: usize, runs:
 /// diagonal `diagonal`): from points on the output to the input's triangles, and back.
 pub fn distances(input: &Mesh, input_points: &[Vec3], diagonal: f32, output: &Mesh) -> Distances {
     distance::between(output, Target::Triangles(input), input_points, diagonal)
+}
+
+/// One input's clusters at one bound, for both kinds (untimed).
+pub struct SweepRow {
+    pub input: String,
+    pub bound: f64,
+    /// `[octree, vstree]`.
+    pub figures: [Figures; 2],
+}
+
+impl SweepRow {
+    /// 1 − VS-Tree clusters / octree clusters.
+    pub fn gain(&self) -> f64 {
+        1.0 - self.figures[1].stats.leaves as f64 / self.figures[0].stats.leaves as f64
+    }
+}
+
+/// Both trees over `samples` at each of `bounds`, one build each: how the gain moves with the
+/// bound, and how much of the VS-Tree lies below the T-layer.
+pub fn sweep(name: &str, samples: &SampleSet, bounds: &[f64], threads: &Threads) -> vstree::Result<Vec<SweepRow>> {
+    let mut rows = Vec::new();
+    for &bound in bounds {
+        let mut figures = [Figures::default(); 2];
+        for (k, kind) in KINDS.into_iter().enumerate() {
+            figures[k] = self::figures(&tree::build(samples, &params(kind, bound), threads, &mut Progress::none())?);
+        }
+        rows.push(SweepRow { input: name.to_string(), bound, figures });
+    }
+    Ok(rows)
 }

@@ -4,7 +4,7 @@ use crate::common::distance::Distances;
 use crate::common::inputs::short_count;
 use crate::common::report::{bound, header, mean_max, ms, percent, seconds, thousands, verdict};
 use crate::common::stats::{geometric_mean, max, median, min};
-use crate::measure::Build;
+use crate::measure::{Build, SweepRow};
 use crate::memory::Memory;
 use std::fmt::Write as _;
 use vstree::TreeKind;
@@ -31,6 +31,11 @@ impl Row {
     /// 1 − VS-Tree clusters / octree clusters.
     pub fn gain(&self) -> f64 {
         1.0 - self.builds[1].stats.leaves as f64 / self.builds[0].stats.leaves as f64
+    }
+
+    /// The same gain on partitions (empty cells counted, as pointer-based trees have them).
+    pub fn partition_gain(&self) -> f64 {
+        1.0 - self.builds[1].partitions as f64 / self.builds[0].partitions as f64
     }
 
     /// VS-Tree build time / octree build time.
@@ -74,6 +79,8 @@ pub struct Report {
     pub rows: Vec<Row>,
     /// Builds of the largest cloud on one thread (same inputs and bounds as in `rows`).
     pub one_thread: Vec<Row>,
+    /// Clusters over a range of bounds (untimed).
+    pub sweep: Vec<SweepRow>,
     pub methods: Vec<Method>,
     pub memory: Vec<Memory>,
     pub context: Context,
@@ -106,6 +113,7 @@ impl Report {
         self.table1(&mut md);
         self.scaling(&mut md);
         self.clusters(&mut md);
+        self.sweep_table(&mut md);
         self.simplification(&mut md);
         self.memory_table(&mut md);
         md
@@ -114,14 +122,19 @@ impl Report {
     fn table1(&self, md: &mut String) {
         md.push_str(
             "### Table 1: build time and clusters at the same L2 bound\n\n\
+             Clusters are the leaves, i.e. the non-empty cells. Partitions also count the empty \
+             cells that a pointer-based tree allocates (every octree split makes 8 cells, every \
+             quadtree split 4). The paper's Table 1 gives its gain \"relative to the final number \
+             of partitions\", and its implementation was pointer-based.\n\n\
              | input | samples | L2 bound | octree build (ms) | VS-Tree build (ms) | VS/oct time \
-             | octree clusters | VS-Tree clusters | gain |\n\
-             |---|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+             | octree clusters | VS-Tree clusters | gain | octree partitions | VS-Tree partitions \
+             | gain |\n\
+             |---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
         );
         for r in &self.rows {
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {} | {:.2} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} |",
                 r.input,
                 thousands(r.samples),
                 bound(r.bound),
@@ -130,7 +143,10 @@ impl Report {
                 r.time_ratio(),
                 thousands(r.builds[0].stats.leaves),
                 thousands(r.builds[1].stats.leaves),
-                percent(r.gain())
+                percent(r.gain()),
+                thousands(r.builds[0].partitions),
+                thousands(r.builds[1].partitions),
+                percent(r.partition_gain())
             );
         }
         md.push('\n');
@@ -199,6 +215,53 @@ impl Report {
                 oct_tris,
                 vs_tris,
                 mean_max(r.distances.and_then(|d| d.out_in)),
+            );
+        }
+        md.push('\n');
+    }
+
+    /// The inputs of the bound sweep, in order.
+    fn sweep_inputs(&self) -> Vec<String> {
+        let mut names: Vec<String> = Vec::new();
+        for r in &self.sweep {
+            if !names.contains(&r.input) {
+                names.push(r.input.clone());
+            }
+        }
+        names
+    }
+
+    fn sweep_table(&self, md: &mut String) {
+        if self.sweep.is_empty() {
+            return;
+        }
+        md.push_str(
+            "### Bound sweep: the gain as the tree deepens\n\n\
+             One untimed build of each tree per bound, on samples drawn uniformly on a sphere \
+             and on the cloud surface. Cells halve at every level, so each tree's cluster count \
+             grows in steps as the bound tightens, and the two trees step at different bounds: \
+             the gain at a single bound swings with where the bound falls between steps. \
+             S-leaves = share of the VS-Tree's clusters below the T-layer.\n\n\
+             | input | L2 bound | octree clusters | VS-Tree clusters | gain | S-leaves \
+             | T-layer depth | octree partitions | VS-Tree partitions | gain |\n\
+             |---|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+        );
+        for r in &self.sweep {
+            let [oct, vs] = &r.figures;
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {}–{} | {} | {} | {} |",
+                r.input,
+                bound(r.bound),
+                thousands(oct.stats.leaves),
+                thousands(vs.stats.leaves),
+                percent(r.gain()),
+                percent(vs.surface_leaves as f64 / vs.stats.leaves.max(1) as f64),
+                vs.stats.t_depth_min,
+                vs.stats.t_depth_max,
+                thousands(oct.partitions),
+                thousands(vs.partitions),
+                percent(1.0 - vs.partitions as f64 / oct.partitions as f64),
             );
         }
         md.push('\n');
@@ -292,6 +355,33 @@ impl Report {
             percent(median(&gains)),
             percent(max(&gains)),
         );
+        let gains: Vec<f64> = self.rows.iter().map(Row::partition_gain).collect();
+        let met = gains.iter().filter(|&&g| g >= GAIN_TARGET).count();
+        let _ = writeln!(
+            md,
+            "  - The same gain on partitions (empty cells counted, see Table 1): met on {met} of {} \
+             rows; min {}, median {}, max {}.",
+            gains.len(),
+            percent(min(&gains)),
+            percent(median(&gains)),
+            percent(max(&gains)),
+        );
+        for input in self.sweep_inputs() {
+            let rows: Vec<&SweepRow> = self.sweep.iter().filter(|r| r.input == input).collect();
+            let gains: Vec<f64> = rows.iter().map(|r| r.gain()).collect();
+            let bounds: Vec<f64> = rows.iter().map(|r| r.bound).collect();
+            let _ = writeln!(
+                md,
+                "  - Over {} bounds from {} to {} (bound sweep below), on {input}: gain min {}, \
+                 median {}, max {}.",
+                gains.len(),
+                bound(max(&bounds)),
+                bound(min(&bounds)),
+                percent(min(&gains)),
+                percent(median(&gains)),
+                percent(max(&gains)),
+            );
+        }
         let ratios: Vec<f64> = self.rows.iter().map(Row::time_ratio).collect();
         let faster = ratios.iter().filter(|&&r| r <= 1.0).count();
         let close = ratios.iter().filter(|&&r| r <= 1.05).count();

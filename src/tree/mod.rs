@@ -30,8 +30,9 @@ pub enum TreeKind {
 /// The error metric that decides whether a cell is split (paper §3.2, "Error metrics").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Metric {
-    /// Quadric error (Garland-Heckbert): RMS distance from the cell's quadric minimiser to the
-    /// samples' tangent planes, relative to the bounding-box diagonal.
+    /// Quadric error (Garland-Heckbert): the sum, over the cell's samples, of the squared
+    /// distance from the cell's representative (its quadric minimiser, kept in the cell) to
+    /// each sample's tangent plane, relative to the squared bounding-box diagonal.
     #[default]
     L2,
     /// Normal deviation (Cohen-Steiner et al. 2004): mean of ‖nⱼ − n̂‖² over the cell's samples
