@@ -152,8 +152,18 @@ pub struct SweepRow {
 impl SweepRow {
     /// 1 − VS-Tree clusters / octree clusters.
     pub fn gain(&self) -> f64 {
-        1.0 - self.figures[1].stats.leaves as f64 / self.figures[0].stats.leaves as f64
+        reduction(self.figures[0].stats.leaves, self.figures[1].stats.leaves)
     }
+
+    /// The same on partitions.
+    pub fn partition_gain(&self) -> f64 {
+        reduction(self.figures[0].partitions, self.figures[1].partitions)
+    }
+}
+
+/// How much smaller the VS-Tree's count is than the octree's: 1 − vstree / octree.
+pub fn reduction(octree: usize, vstree: usize) -> f64 {
+    1.0 - vstree as f64 / octree.max(1) as f64
 }
 
 /// Both trees over `samples` at each of `bounds`, one build each: how the gain moves with the

@@ -4,7 +4,7 @@ use crate::common::distance::Distances;
 use crate::common::inputs::short_count;
 use crate::common::report::{bound, header, mean_max, ms, percent, seconds, thousands, verdict};
 use crate::common::stats::{geometric_mean, max, median, min};
-use crate::measure::{Build, SweepRow};
+use crate::measure::{reduction, Build, SweepRow};
 use crate::memory::Memory;
 use std::fmt::Write as _;
 use vstree::TreeKind;
@@ -30,12 +30,12 @@ pub struct Row {
 impl Row {
     /// 1 − VS-Tree clusters / octree clusters.
     pub fn gain(&self) -> f64 {
-        1.0 - self.builds[1].stats.leaves as f64 / self.builds[0].stats.leaves as f64
+        reduction(self.builds[0].stats.leaves, self.builds[1].stats.leaves)
     }
 
     /// The same gain on partitions (empty cells counted, as pointer-based trees have them).
     pub fn partition_gain(&self) -> f64 {
-        1.0 - self.builds[1].partitions as f64 / self.builds[0].partitions as f64
+        reduction(self.builds[0].partitions, self.builds[1].partitions)
     }
 
     /// VS-Tree build time / octree build time.
@@ -261,7 +261,7 @@ impl Report {
                 vs.stats.t_depth_max,
                 thousands(oct.partitions),
                 thousands(vs.partitions),
-                percent(1.0 - vs.partitions as f64 / oct.partitions as f64),
+                percent(r.partition_gain()),
             );
         }
         md.push('\n');
