@@ -24,6 +24,8 @@ fn simplify_writes_a_smaller_mesh_and_reports_what_it_did() {
     let run = vstree(&["simplify", input.to_str().unwrap(), output.to_str().unwrap(), "--error", "1e-4"]);
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&run.stderr));
+    // stderr is a pipe here, not a terminal: no progress bar, nothing at all.
+    assert!(run.stderr.is_empty(), "stderr: {}", String::from_utf8_lossy(&run.stderr));
     let out = io::read(&output).unwrap();
     assert!(out.triangles.len() < torus.triangles.len() / 4 && !out.triangles.is_empty());
     for needle in [
@@ -85,10 +87,30 @@ fn errors_name_the_problem_and_leave_no_output() {
     io::write(&input, &shapes::icosphere(1.0, 2)).unwrap();
     let run = vstree(&["simplify", input.to_str().unwrap(), output.to_str().unwrap(), "--error", "-1"]);
     assert!(!run.status.success());
-    assert!(String::from_utf8_lossy(&run.stderr).contains("parameter `error`"));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("--error: -1"));
+    assert!(!output.exists());
+    let run = vstree(&["simplify", input.to_str().unwrap(), output.to_str().unwrap(), "--dd", "2"]);
+    assert!(String::from_utf8_lossy(&run.stderr).contains("--dd: 2: must be in [0, 1]"));
     assert!(!output.exists());
     let run = vstree(&["simplify", input.to_str().unwrap(), dir.join("out.stl").to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&run.stderr).contains("unsupported"));
+    // The output's format is checked before the input is read: no wait for a useless run.
+    let missing = dir.join("missing.ply");
+    let run = vstree(&["simplify", missing.to_str().unwrap(), dir.join("out.stl").to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&run.stderr).contains("out.stl: unsupported"));
+
+    // The input is never overwritten, even by a run that would succeed; nor through a link.
+    let before = std::fs::read(&input).unwrap();
+    let link = dir.join("link.off");
+    std::os::unix::fs::symlink(&input, &link).unwrap();
+    for out in [&input, &link] {
+        for command in ["simplify", "reconstruct"] {
+            let run = vstree(&[command, input.to_str().unwrap(), out.to_str().unwrap()]);
+            let stderr = String::from_utf8_lossy(&run.stderr);
+            assert!(!run.status.success() && stderr.contains("is the input file"), "{command}: {stderr}");
+        }
+    }
+    assert_eq!(std::fs::read(&input).unwrap(), before);
     std::fs::remove_dir_all(dir).unwrap();
 }
 
@@ -100,4 +122,38 @@ fn help_explains_every_parameter() {
         assert!(help.contains(flag), "--help lacks {flag}");
     }
     assert!(help.contains("sqrt(error)"), "the error bound is not explained");
+    assert!(help.contains("--min-cell-size"), "--help lacks --min-cell-size");
+    // Each value of --tree and --metric is explained, not just listed.
+    for value in ["Quadric error", "Normal deviation", "Sample count", "plain octree"] {
+        assert!(help.contains(value), "--help does not explain {value:?}");
+    }
+    let run = vstree(&["stats", "--help"]);
+    let help = String::from_utf8_lossy(&run.stdout);
+    for flag in ["--tree", "--metric", "--error", "--da", "--dd", "--threads", "--sampling", "--compare"] {
+        assert!(help.contains(flag), "stats --help lacks {flag}");
+    }
+}
+
+#[test]
+fn a_cloud_without_normals_gets_them_estimated() {
+    let dir = temp_dir("no-normals");
+    let input = dir.join("points.xyz");
+    let mut cloud = shapes::sample_surface(&shapes::icosphere(1.0, 4), 20_000, 3);
+    cloud.normals = None;
+    io::write(&input, &cloud).unwrap();
+    let run = vstree(&["stats", input.to_str().unwrap(), "--error", "1e-4"]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}{}", String::from_utf8_lossy(&run.stderr));
+    assert!(stdout.contains("normals: 20000 estimated") && stdout.contains("T-layer depth"), "{stdout}");
+    let output = dir.join("simplified.ply");
+    let run = vstree(&["simplify", input.to_str().unwrap(), output.to_str().unwrap(), "--error", "1e-4"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let out = io::read(&output).unwrap();
+    // One point per cluster, each with a unit normal pointing out of the sphere.
+    let normals = out.normals.expect("clusters carry normals");
+    assert!(out.positions.len() > 100 && out.positions.len() < 20_000);
+    for (p, n) in out.positions.iter().zip(&normals) {
+        assert!((n.length() - 1.0).abs() < 1e-4 && n.dot(p.normalize()) > 0.9, "{p} {n}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
 }

@@ -25,10 +25,11 @@ struct Cli {
 #[derive(Subcommand)]
 #[command(args_conflicts_with_subcommands = false)]
 enum Command {
-    /// Simplify a mesh (or a point cloud with normals) by clustering in a VS-Tree.
+    /// Simplify a mesh (or a point cloud) by clustering in a VS-Tree.
     ///
     /// Every leaf of the tree becomes one output vertex, placed where it best fits the samples'
-    /// tangent planes; triangles are re-indexed, and those that collapse are dropped.
+    /// tangent planes; triangles are re-indexed, and those that collapse are dropped. A point
+    /// cloud without normals gets them estimated first.
     Simplify {
         /// Input file: .ply, .obj, .off, .xyz or .pwn.
         input: PathBuf,
@@ -78,7 +79,7 @@ enum Command {
         #[arg(long)]
         ascii: bool,
     },
-    /// Run both jobs on a generated sample, no input needed: a bumpy sphere of 650k triangles is
+    /// Run both jobs on a generated sample, no input needed: a bumpy sphere of 1.3M triangles is
     /// simplified (VS-Tree and octree side by side), and a noisy 200k-point cloud drawn on a
     /// genus-3 shape is reconstructed. Everything is written to the output folder.
     Demo {
@@ -92,6 +93,9 @@ enum Command {
         input: PathBuf,
         #[command(flatten)]
         tree: TreeArgs,
+        /// Which mesh elements become samples.
+        #[arg(long, value_enum, default_value_t = Sampling::Vertices)]
+        sampling: Sampling,
         /// Also build the other kind of tree (octree or VS-Tree) and compare cluster counts.
         #[arg(long)]
         compare: bool,
@@ -110,8 +114,9 @@ struct TreeArgs {
     #[arg(long, value_enum, default_value_t = MetricArg::L2)]
     metric: MetricArg,
     /// Error bound per cluster. L2: sum of squared sample-plane distances over the squared
-    /// bounding-box diagonal (every sample then lies within sqrt(error) x diagonal of its
-    /// cluster's point); l21: mean squared normal deviation (0-4); density: samples per cluster.
+    /// bounding-box diagonal (every sample's tangent plane then passes within sqrt(error) x
+    /// diagonal of its cluster's point); l21: mean squared normal deviation (0-4); density:
+    /// samples per cluster.
     /// Larger = coarser output (and, to reconstruct, smoother: it is the de-noising control).
     /// [default: 2e-3 to simplify and for stats, 1e-5 to reconstruct]
     #[arg(long, allow_negative_numbers = true)]
@@ -128,24 +133,34 @@ struct TreeArgs {
     /// Deepest tree level (1-30).
     #[arg(long, default_value_t = 24)]
     max_depth: u32,
+    /// Cells smaller than this fraction of the bounding-box diagonal are not split, in [0, 1):
+    /// guards against duplicate points.
+    #[arg(long, default_value_t = TreeParams::default().min_cell_size)]
+    min_cell_size: f64,
     /// Worker threads (0 = all cores).
     #[arg(long, default_value_t = 0)]
     threads: usize,
-    /// Print nothing but errors.
+    /// No progress bar and no report: print nothing but errors (`stats` still prints its
+    /// statistics, which are its output).
     #[arg(long, short)]
     quiet: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
 enum Kind {
+    /// Octree far from the surface, quadtrees in its tangent planes near it (the paper's).
     Vstree,
+    /// A plain octree with the same metric and bound: the baseline to compare with.
     Octree,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
 enum MetricArg {
+    /// Quadric error: how far the cluster's point is from its samples' tangent planes.
     L2,
+    /// Normal deviation: how much the cluster's normals differ from their mean.
     L21,
+    /// Sample count: at most `--error` samples per cluster (cheap, for huge inputs).
     Density,
 }
 
@@ -155,6 +170,15 @@ enum Sampling {
     Vertices,
     /// One sample per face, at its centre.
     Faces,
+}
+
+impl From<Sampling> for MeshSampling {
+    fn from(s: Sampling) -> MeshSampling {
+        match s {
+            Sampling::Vertices => MeshSampling::Vertices,
+            Sampling::Faces => MeshSampling::FaceCenters,
+        }
+    }
 }
 
 impl TreeArgs {
@@ -173,7 +197,7 @@ impl TreeArgs {
             d_a: self.da,
             d_d: self.dd,
             max_depth: self.max_depth,
-            ..TreeParams::default()
+            min_cell_size: self.min_cell_size,
         }
     }
 }
@@ -183,10 +207,78 @@ fn main() -> ExitCode {
     match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("vstree: error: {e}");
+            eprintln!("vstree: error: {}", message(&e));
             ExitCode::FAILURE
         }
     }
+}
+
+/// The error as the user should read it: parameters named by their command-line flags.
+fn message(e: &vstree::Error) -> String {
+    let vstree::Error::InvalidParameter { name, message } = e else {
+        return e.to_string();
+    };
+    let flag = match *name {
+        "error" => "--error",
+        "d_a" => "--da",
+        "d_d" => "--dd",
+        "max_depth" => "--max-depth",
+        "min_cell_size" => "--min-cell-size",
+        "threads" => "--threads",
+        "target_distance" => "--target",
+        "max_levels" => "--levels",
+        "trim" => "--trim",
+        "k" | "neighbours" => "--neighbours",
+        _ => return e.to_string(),
+    };
+    format!("{flag}: {message}")
+}
+
+/// Refuses, before any work is done, an output vstree cannot write or that is the input itself
+/// (the input is never overwritten, even by a successful run).
+fn check_output(input: &Path, output: &Path) -> vstree::Result<()> {
+    if io::Format::from_path(output).is_none() {
+        return Err(vstree::Error::UnsupportedFormat { path: output.to_path_buf() });
+    }
+    if same_file(input, output) {
+        return Err(vstree::Error::InvalidInput(format!(
+            "the output {} is the input file: write the result to another file",
+            output.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Whether both paths name one existing file (through links too).
+fn same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        x.dev() == y.dev() && x.ino() == y.ino()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (x, y);
+        std::fs::canonicalize(a).ok() == std::fs::canonicalize(b).ok()
+    }
+}
+
+/// Reads `path`; a point cloud without normals (or with some zero) gets them estimated, since
+/// simplification and the tree need them (reconstruction estimates its own).
+fn read_with_normals(path: &Path, threads: usize, quiet: bool) -> vstree::Result<vstree::Mesh> {
+    let mut mesh = io::read(path)?;
+    let usable = |n: &Vec<glam::Vec3>| n.iter().all(|v| *v != glam::Vec3::ZERO);
+    if mesh.is_point_cloud() && !mesh.normals.as_ref().is_some_and(usable) {
+        let params = vstree::normals::NormalParams { threads, ..Default::default() };
+        let report = with_progress(quiet, |p| vstree::normals::ensure_normals(&mut mesh, &params, p))?;
+        if !quiet {
+            println!("normals: {} estimated from {} neighbours", report.estimated, report.neighbours);
+        }
+    }
+    Ok(mesh)
 }
 
 fn run(command: Command) -> vstree::Result<()> {
@@ -194,13 +286,11 @@ fn run(command: Command) -> vstree::Result<()> {
         Command::Simplify { input, output, tree, sampling, ascii } => {
             let tree_params = tree.params(SIMPLIFY_ERROR);
             tree_params.check()?; // before reading what may be a large file
-            let (mesh, read_s) = timed(|| io::read(&input))?;
+            check_output(&input, &output)?;
+            let (mesh, read_s) = timed(|| read_with_normals(&input, tree.threads, tree.quiet))?;
             let params = SimplifyParams {
                 tree: tree_params,
-                sampling: match sampling {
-                    Sampling::Vertices => MeshSampling::Vertices,
-                    Sampling::Faces => MeshSampling::FaceCenters,
-                },
+                sampling: sampling.into(),
                 threads: tree.threads,
             };
             let (out, stats) = with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
@@ -222,6 +312,7 @@ fn run(command: Command) -> vstree::Result<()> {
                 ..ReconstructParams::default()
             };
             params.check()?;
+            check_output(&input, &output)?;
             let (mut cloud, read_s) = timed(|| io::read(&input))?;
             cloud.triangles.clear();
             let (out, stats) = with_progress(tree.quiet, |progress| reconstruct(&cloud, &params, progress))?;
@@ -232,14 +323,14 @@ fn run(command: Command) -> vstree::Result<()> {
             Ok(())
         }
         Command::Demo { out } => demo(&out),
-        Command::Stats { input, tree, compare } => {
+        Command::Stats { input, tree, sampling, compare } => {
             let tree_params = tree.params(SIMPLIFY_ERROR);
             tree_params.check()?;
-            let mesh = io::read(&input)?;
+            let mesh = read_with_normals(&input, tree.threads, tree.quiet)?;
             let samples = if mesh.is_point_cloud() {
                 SampleSet::from_cloud(&mesh)?
             } else {
-                SampleSet::from_mesh(&mesh, MeshSampling::Vertices)?
+                SampleSet::from_mesh(&mesh, sampling.into())?
             };
             let threads = Threads::new(tree.threads)?;
             let mut kinds = vec![tree_params];
