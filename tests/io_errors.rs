@@ -151,7 +151,7 @@ fn absurd_counts_in_tiny_files_fail_fast() {
         end_header\n0 0 0\n0 0 0\n0 0 0\n4294967295 0 1 2\n";
     let (location, message) = ply(ascii);
     assert_eq!(location, "line 13");
-    assert!(message.contains("file ends in face 0"), "{message}");
+    assert!(message.contains("face 0: expected 4294967296 values, found 4"), "{message}");
     let (_, message) = off("OFF\n4000000000 4000000000 0\n0 0 0\n");
     assert!(message.contains("file ends in vertex 1 of 4000000000"), "{message}");
     // Elements without properties occupy no bytes, whatever their count.
@@ -192,6 +192,186 @@ fn nan_coordinates_name_the_vertex() {
     assert!(message.contains("point 1"), "{message}");
     let obj = io::obj::parse(b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Path::new("bad.obj"));
     parse_error(obj, "bad.obj");
+}
+
+/// An ASCII PLY of `count` vertices with normals and no faces; the body starts on line 11.
+fn ascii_ply_with_normals(count: usize, body: &str) -> Vec<u8> {
+    format!(
+        "ply\nformat ascii 1.0\nelement vertex {count}\nproperty float x\nproperty float y\n\
+         property float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n{body}"
+    )
+    .into_bytes()
+}
+
+/// A binary PLY of three vertices with normals, all `+z` but vertex `bad`'s, which is `normal`.
+fn binary_ply_with_normals(bad: usize, normal: [f32; 3]) -> Vec<u8> {
+    let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+        property float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\n\
+        end_header\n"
+        .to_vec();
+    for i in 0..3 {
+        let n = if i == bad { normal } else { [0.0, 0.0, 1.0] };
+        for c in [i as f32, 0.0, 0.0].into_iter().chain(n) {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    bytes
+}
+
+fn obj(src: &str) -> (String, String) {
+    parse_error(io::obj::parse(src.as_bytes(), Path::new("bad.obj")), "bad.obj")
+}
+
+#[test]
+fn non_finite_normals_name_the_line_or_element() {
+    let (location, message) = ply(&binary_ply_with_normals(2, [0.0, f32::NAN, 1.0]));
+    assert_eq!(location, "vertex 2");
+    assert!(message.contains("NaN or infinite normal component (0, NaN, 1)"), "{message}");
+    let (location, message) = ply(&binary_ply_with_normals(0, [f32::NEG_INFINITY, 0.0, 0.0]));
+    assert_eq!(location, "vertex 0");
+    assert!(message.contains("normal component (-inf, 0, 0)"), "{message}");
+    let (location, message) = ply(&ascii_ply_with_normals(3, "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 nan 0 1\n"));
+    assert_eq!(location, "line 13");
+    assert!(message.contains("vertex 2: has a NaN or infinite normal component"), "{message}");
+    let (location, message) = xyz("# n\n0 0 0 0 0 1\n1 1 1 0 inf 1\n");
+    assert_eq!(location, "line 3");
+    assert!(message.contains("point 1: has a NaN or infinite normal component (0, inf, 1)"), "{message}");
+    let (location, message) = off("NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 NaN\n0 1 0 0 0 1\n3 0 1 2\n");
+    assert_eq!(location, "line 4");
+    assert!(message.contains("vertex 1: has a NaN or infinite normal component"), "{message}");
+    // OBJ per-vertex normals (kept) name their `vn` line, though tobj renumbers vertices.
+    let src = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\nvn nan 0 1\nf 3//3 2//2 1//1\n";
+    let (location, message) = obj(src);
+    assert_eq!(location, "line 6");
+    assert!(message.contains("normal 2 has a NaN or infinite normal component"), "{message}");
+    let (location, message) = obj("v 0 0 0\nv 1 0 0\nvn 0 0 1\nvn 0 inf 0\n");
+    assert_eq!(location, "line 4");
+    assert!(message.contains("normal 1 has a NaN"), "{message}");
+}
+
+#[test]
+fn dropped_or_zero_normals_are_not_reader_errors() {
+    // One `vn` shared by all corners is not per-vertex, so it is dropped, NaN or not.
+    let mesh = io::obj::parse(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan 0 1\nf 1//1 2//1 3//1\n", Path::new("a.obj"));
+    assert!(mesh.unwrap().normals.is_none());
+    let mesh = io::obj::parse(b"v 0 0 0\nv 1 0 0\nvn nan 0 0\n", Path::new("a.obj")).unwrap();
+    assert!(mesh.normals.is_none());
+    let mesh = io::ply::parse(&binary_ply_with_normals(1, [0.0; 3]), Path::new("a.ply")).unwrap();
+    assert_eq!(mesh.normals.unwrap()[1], glam::Vec3::ZERO);
+    let mesh = io::xyz::parse(b"0 0 0 0 0 0\n", Path::new("a.xyz")).unwrap();
+    assert_eq!(mesh.normals.unwrap()[0], glam::Vec3::ZERO);
+}
+
+#[test]
+fn ascii_ply_items_end_at_their_line() {
+    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n"));
+    assert_eq!(location, "line 11");
+    assert_eq!(message, "vertex 1: expected 3 values, found 4");
+    let (location, message) = ply(&ascii_ply("0 0 0\n1 0\n0 1 0\n3 0 1 2\n"));
+    assert_eq!(location, "line 11");
+    assert_eq!(message, "vertex 1: expected 3 values, found 2");
+    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1\n"));
+    assert_eq!(location, "line 13");
+    assert_eq!(message, "face 0: expected 4 values, found 3");
+    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1 2 1\n"));
+    assert_eq!(location, "line 13");
+    assert_eq!(message, "face 0: expected 4 values, found 5");
+    let body = "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n1 1 0 0 0 1 5\n";
+    let (location, message) = ply(&ascii_ply_with_normals(4, body));
+    assert_eq!(location, "line 14");
+    assert_eq!(message, "vertex 3: expected 6 values, found 7");
+    // A list not read yet counts only its length: the expected count is a lower bound.
+    let two_lists = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+        property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+        property list uchar float texcoord\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n";
+    let (location, message) = ply(two_lists);
+    assert_eq!(location, "line 14");
+    assert_eq!(message, "face 0: expected at least 5 values, found 3");
+    // A vertex line missing from the middle is reported where the items stop matching.
+    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n3 0 1 2\n"));
+    assert_eq!(location, "line 12");
+    assert_eq!(message, "vertex 2: expected 3 values, found 4");
+}
+
+#[test]
+fn ascii_ply_tolerates_blank_lines_trailing_spaces_and_crlf() {
+    let body = "\r\n0 0 0 \r\n\n  1 0 0\t\r\n0 1 0\r\n   \n3 0 1 2  \r\n\n";
+    let mesh = io::ply::parse(&ascii_ply(body), Path::new("ok.ply")).unwrap();
+    assert_eq!((mesh.positions.len(), mesh.triangles.len()), (3, 1));
+    let mesh = io::ply::parse(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1 2"), Path::new("ok.ply")).unwrap();
+    assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+    // Skipped blank lines still count for the line numbers.
+    let (location, message) = ply(&ascii_ply("0 0 0\n\n\r\n1 0 0 5\n0 1 0\n3 0 1 2\n"));
+    assert_eq!(location, "line 13");
+    assert_eq!(message, "vertex 1: expected 3 values, found 4");
+    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n\n\n"));
+    assert_eq!(location, "line 12");
+    assert_eq!(message, "file ends in face 0 of 1");
+}
+
+#[test]
+fn obj_errors_name_the_line() {
+    let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    let (location, message) = obj(&format!("{tri}f 1 2 3\nf 1 2 9\n"));
+    assert_eq!(location, "line 5");
+    assert!(message.contains("vertex index 9 is out of range: the file has 3 `v` lines"), "{message}");
+    let (location, message) = obj(&format!("{tri}f 0 1 2\n"));
+    assert_eq!(location, "line 4");
+    assert!(message.contains("vertex index 0 is invalid"), "{message}");
+    let (location, message) = obj("# relative\nv 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n");
+    assert_eq!(location, "line 4");
+    assert!(message.contains("relative vertex index -3") && message.contains("only 2 `v` lines"), "{message}");
+    let (location, message) = obj("v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n");
+    assert_eq!(location, "line 3");
+    assert!(message.contains("`zero`"), "{message}");
+    let (location, message) = obj(&format!("{tri}vn 0 0 1\nf 1//1 2//1 3//2\n"));
+    assert_eq!(location, "line 5");
+    assert!(message.contains("normal index 2 is out of range"), "{message}");
+    let (location, message) = obj(&format!("{tri}f 1 2/x 3\n"));
+    assert_eq!(location, "line 4");
+    assert!(message.contains("`2/x`"), "{message}");
+    // Makes tobj index out of bounds (a panic it does not guard against): still located.
+    let (location, message) = obj(&format!("{tri}vn 0 0 1\nf 1//1 2//1 3//6148914691236517206\n"));
+    assert_eq!(location, "line 5");
+    assert!(message.contains("normal index 6148914691236517206 is out of range"), "{message}");
+    // Points and lines are ignored, whatever their indices.
+    io::obj::parse(format!("{tri}f 1 99\nl 5 6\nf 1 2 3\n").as_bytes(), Path::new("ok.obj")).unwrap();
+    // A forward reference across objects fails in tobj but not in the scan: whole-file location.
+    let (location, message) = obj("o a\nv 0 0 0\nv 1 0 0\nf 1 2 3\no b\nv 0 1 0\n");
+    assert_eq!(location, "OBJ data");
+    assert!(message.contains("out of bounds"), "{message}");
+}
+
+#[test]
+fn obj_non_finite_vertices_name_their_line() {
+    let (location, message) = obj("v 0 0 0\nv 1 0 0\nv 0 nan 0\nv 0 1 0\nf 1 2 4\nf 4 3 1\n");
+    assert_eq!(location, "line 3");
+    assert_eq!(message, "vertex 2 has a NaN or infinite coordinate (0, NaN, 0)");
+    // A vertex no face uses is dropped by tobj, so it is no error.
+    let mesh = io::obj::parse(b"v inf 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 2 3 4\n", Path::new("ok.obj"));
+    assert_eq!(mesh.unwrap().positions.len(), 3);
+}
+
+/// The errors of files read from disk name the file and the line.
+#[test]
+fn errors_from_files_name_path_and_line() {
+    let dir = std::env::temp_dir().join(format!("vstree-io-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases: [(&str, &[u8], &str); 4] = [
+        ("normal.ply", &ascii_ply_with_normals(2, "0 0 0 0 0 1\n1 0 0 0 inf 1\n"), "line 12: vertex 1: has a NaN"),
+        ("short.ply", &ascii_ply("0 0 0\n1 0\n0 1 0\n3 0 1 2\n"), "line 11: vertex 1: expected 3 values, found 2"),
+        ("index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", "line 4: relative vertex index -4"),
+        ("normal.pwn", b"0 0 0 0 0 1\n1 1 1 nan 0 0\n", "line 2: point 1: has a NaN or infinite normal"),
+    ];
+    for (name, bytes, expected) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let err = io::read(&path).unwrap_err();
+        assert!(matches!(&err, Error::Parse { path: p, .. } if *p == path), "{err:?}");
+        let shown = err.to_string();
+        assert!(shown.starts_with(&format!("{}: {expected}", path.display())), "{shown}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -1,6 +1,6 @@
 //! Checks every reader applies while turning parsed numbers into mesh parts: face indices in
-//! range, faces with at least three corners, finite positions, and allocations bounded by the
-//! input's size. Messages are predicates meant to follow a subject such as `face 3: `.
+//! range, faces with at least three corners, finite positions and normals, and allocations
+//! bounded by the input's size. Messages are predicates meant to follow a subject such as `face 3: `.
 
 use glam::Vec3;
 
@@ -31,10 +31,20 @@ pub(crate) fn push_fan(polygon: &[u32], triangles: &mut Vec<[u32; 3]>) -> Result
 
 /// Returns `p` if all its coordinates are finite.
 pub(crate) fn finite_position(p: Vec3) -> Result<Vec3, String> {
-    if p.is_finite() {
-        Ok(p)
+    finite(p, "coordinate")
+}
+
+/// Returns `n` if all its components are finite. Zero-length normals pass: they are valid
+/// input, and the stages that use normals decide what to do with them.
+pub(crate) fn finite_normal(n: Vec3) -> Result<Vec3, String> {
+    finite(n, "normal component")
+}
+
+fn finite(v: Vec3, what: &str) -> Result<Vec3, String> {
+    if v.is_finite() {
+        Ok(v)
     } else {
-        Err(format!("has a NaN or infinite coordinate ({}, {}, {})", p.x, p.y, p.z))
+        Err(format!("has a NaN or infinite {what} ({}, {}, {})", v.x, v.y, v.z))
     }
 }
 
@@ -72,6 +82,13 @@ mod tests {
         assert!(vertex_index(5, 5).unwrap_err().contains("only 5 vertices"));
         assert!(vertex_index(-1, 5).unwrap_err().contains("negative"));
         assert!(vertex_index(i64::MAX, usize::MAX).is_err());
+    }
+
+    #[test]
+    fn rejects_non_finite_but_not_zero_normals() {
+        assert_eq!(finite_normal(Vec3::ZERO), Ok(Vec3::ZERO));
+        assert!(finite_normal(Vec3::new(0.0, f32::NAN, 1.0)).unwrap_err().contains("normal component (0, NaN, 1)"));
+        assert!(finite_position(Vec3::new(f32::INFINITY, 0.0, 0.0)).unwrap_err().contains("coordinate (inf, 0, 0)"));
     }
 
     #[test]

@@ -4,16 +4,23 @@
 //! `f`) are ignored. tobj numbers vertices in order of first use by a face and drops the ones
 //! no face uses; a file with no faces is read as a point cloud of all its `v` lines. Normals are
 //! kept only when they are per-vertex: as many normals as positions, indexed like them.
+//! Positions, and normals when kept, must be finite.
+//!
+//! tobj reports no line numbers, so when it fails the source is scanned again ([`scan`]) to
+//! name the first malformed line; only if none is found is the error located at the file.
+
+mod scan;
 
 use crate::error::{Error, Result};
 use crate::io::{assemble, text};
 use crate::mesh::Mesh;
 use glam::Vec3;
+use scan::Data;
 use std::io::{self, Write};
 use std::panic::{self, AssertUnwindSafe};
 use std::path::Path;
 
-/// tobj reports no line numbers; errors it finds are located at this.
+/// The location of errors that no line can be found for.
 const WHOLE_FILE: &str = "OBJ data";
 
 /// Parses a whole OBJ file held in memory. `path` is used only in error messages; material
@@ -37,17 +44,36 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     }));
     let models = match loaded {
         Ok(Ok((models, _materials))) => models,
-        Ok(Err(e)) => return Err(Error::parse(path, WHOLE_FILE, e.to_string())),
-        Err(_) => return Err(Error::parse(path, WHOLE_FILE, "malformed face indices")),
+        Ok(Err(e)) => return Err(rejected(&source, path, e.to_string())),
+        Err(_) => return Err(rejected(&source, path, "malformed face indices".into())),
     };
     if models.iter().all(|m| m.mesh.indices.is_empty()) {
         return points(&source, path);
     }
-    merge(&models, path)
+    merge(&models, &source, path)
+}
+
+/// The error for a file tobj rejected with `message`: at the first malformed line, or at the
+/// whole file if the scan finds none.
+fn rejected(source: &str, path: &Path, message: String) -> Error {
+    match scan::first_malformed(source) {
+        Some((n, problem)) => Error::parse(path, format!("line {n}"), problem),
+        None => Error::parse(path, WHOLE_FILE, message),
+    }
+}
+
+/// The error for a non-finite position or normal in tobj's output: at the `v` or `vn` line it
+/// came from (tobj renumbers vertices, so the source is scanned for it), or with `fallback`
+/// at the whole file.
+fn non_finite(source: &str, path: &Path, data: Data, fallback: String) -> Error {
+    match scan::first_non_finite_use(source, data) {
+        Some((n, problem)) => Error::parse(path, format!("line {n}"), problem),
+        None => Error::parse(path, WHOLE_FILE, fallback),
+    }
 }
 
 /// Concatenates tobj's models, offsetting each one's indices.
-fn merge(models: &[tobj::Model], path: &Path) -> Result<Mesh> {
+fn merge(models: &[tobj::Model], source: &str, path: &Path) -> Result<Mesh> {
     let mut mesh = Mesh { normals: Some(Vec::new()), ..Mesh::default() };
     for model in models {
         let m = &model.mesh;
@@ -57,7 +83,7 @@ fn merge(models: &[tobj::Model], path: &Path) -> Result<Mesh> {
             let p = Vec3::new(p[0], p[1], p[2]);
             let vertex = mesh.positions.len();
             let p = assemble::finite_position(p)
-                .map_err(|e| Error::parse(path, WHOLE_FILE, format!("vertex {vertex} {e}")))?;
+                .map_err(|e| non_finite(source, path, Data::Position, format!("vertex {vertex} {e}")))?;
             mesh.positions.push(p);
         }
         for t in m.indices.chunks_exact(3) {
@@ -69,7 +95,12 @@ fn merge(models: &[tobj::Model], path: &Path) -> Result<Mesh> {
         let per_vertex = m.normals.len() == m.positions.len() && m.normal_indices == m.indices;
         match &mut mesh.normals {
             Some(normals) if per_vertex => {
-                normals.extend(m.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])))
+                for n in m.normals.chunks_exact(3) {
+                    let vertex = normals.len(); // normals are per vertex, so this is its index
+                    let n = assemble::finite_normal(Vec3::new(n[0], n[1], n[2]))
+                        .map_err(|e| non_finite(source, path, Data::Normal, format!("vertex {vertex}: {e}")))?;
+                    normals.push(n);
+                }
             }
             _ => mesh.normals = None,
         }
@@ -78,10 +109,12 @@ fn merge(models: &[tobj::Model], path: &Path) -> Result<Mesh> {
 }
 
 /// A file without faces: every `v` line is a point; `vn` lines are its normals when there is
-/// exactly one per point.
+/// exactly one per point, and must then be finite.
 fn points(source: &str, path: &Path) -> Result<Mesh> {
     let mut positions = Vec::new();
     let mut normals = Vec::new();
+    // The first non-finite normal; an error only if the normals are kept.
+    let mut bad_normal = None;
     for (n, line) in text::lines(source.as_bytes()) {
         let mut words = line.split_whitespace();
         let is_position = match words.next() {
@@ -100,10 +133,17 @@ fn points(source: &str, path: &Path) -> Result<Mesh> {
             let p = assemble::finite_position(Vec3::from(xyz)).map_err(|m| at(format!("vertex {vertex} {m}")))?;
             positions.push(p);
         } else {
+            let normal = normals.len();
+            if let (None, Err(m)) = (&bad_normal, assemble::finite_normal(Vec3::from(xyz))) {
+                bad_normal = Some(at(format!("normal {normal} {m}")));
+            }
             normals.push(Vec3::from(xyz));
         }
     }
     let has_normals = !normals.is_empty() && normals.len() == positions.len();
+    if let (true, Some(error)) = (has_normals, bad_normal) {
+        return Err(error);
+    }
     Ok(Mesh::from_points(positions, has_normals.then_some(normals)))
 }
 

@@ -1,7 +1,8 @@
 //! OFF (Object File Format): `OFF`, `NOFF` (normals after each position), `COFF` (colors,
 //! ignored) and their combinations. The counts may share the keyword's line; `#` starts a
 //! comment; polygons are fan-triangulated and anything after a face's indices (a color) is
-//! ignored. The writer writes plain `OFF`, which has no normals.
+//! ignored. Positions and normals must be finite. The writer writes plain `OFF`, which has no
+//! normals.
 
 use crate::error::{Error, Result};
 use crate::io::{assemble, text};
@@ -48,7 +49,8 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         let p = Vec3::new(values[0], values[1], values[2]);
         positions.push(assemble::finite_position(p).map_err(|m| at(n, format!("vertex {i}: {m}")))?);
         if let Some(normals) = &mut normals {
-            normals.push(Vec3::new(values[3], values[4], values[5]));
+            let normal = assemble::finite_normal(Vec3::new(values[3], values[4], values[5]));
+            normals.push(normal.map_err(|m| at(n, format!("vertex {i}: {m}")))?);
         }
     }
 

@@ -1,5 +1,6 @@
 //! XYZ / PWN point clouds: one point per line, `x y z` or `x y z nx ny nz`, the same number of
-//! columns on every line. Blank lines and lines starting with `#` are skipped.
+//! columns on every line. Blank lines and lines starting with `#` are skipped. Positions and
+//! normals must be finite.
 
 use crate::error::{Error, Result};
 use crate::io::{assemble, text};
@@ -38,7 +39,8 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         let point = positions.len();
         positions.push(assemble::finite_position(p).map_err(|m| at(format!("point {point}: {m}")))?);
         if let [_, _, _, nx, ny, nz] = values[..] {
-            normals.push(Vec3::new(nx, ny, nz));
+            let normal = assemble::finite_normal(Vec3::new(nx, ny, nz));
+            normals.push(normal.map_err(|m| at(format!("point {point}: {m}")))?);
         }
     }
     assemble::vertex_count_fits(positions.len()).map_err(|m| Error::TooLarge(format!("{}: {m}", path.display())))?;

@@ -1,4 +1,10 @@
-//! The body of an ASCII PLY file: whitespace-separated tokens, read in header order.
+//! The body of an ASCII PLY file: one item per line, its values separated by spaces or tabs,
+//! read in header order.
+//!
+//! Each item must be exactly one line: too few or too many values are reported at that line,
+//! with the count expected. Blank (whitespace-only) lines between items are skipped, since an
+//! item always holds at least one value and so a blank line cannot be one; trailing
+//! whitespace and `\r\n` line ends are accepted.
 
 use super::header::Header;
 use super::items::{self, Cursor, Fail, Parts};
@@ -11,7 +17,7 @@ use std::path::Path;
 
 /// Reads the body `bytes`, which starts on line `first_line`.
 pub(crate) fn read(bytes: &[u8], first_line: usize, header: &Header, plan: &Plan, path: &Path) -> Result<Mesh> {
-    let mut tokens = Tokens { bytes, pos: 0, line: first_line, token_line: first_line };
+    let mut tokens = Tokens { bytes, pos: 0, line: first_line, item_line: first_line, found: 0 };
     let mut parts = Parts::new(plan.vertex_count, plan.has_normals);
     for (element, job) in header.elements.iter().zip(&plan.jobs) {
         items::read_element(&mut tokens, element, job, &mut parts, path)?;
@@ -19,38 +25,40 @@ pub(crate) fn read(bytes: &[u8], first_line: usize, header: &Header, plan: &Plan
     Ok(parts.into_mesh())
 }
 
-/// Whitespace-separated tokens with line tracking (`\r` counts as whitespace).
+/// Whitespace-separated tokens, read one line (item) at a time.
 struct Tokens<'a> {
     bytes: &'a [u8],
     pos: usize,
     /// Line at `pos`.
     line: usize,
-    /// Line of the last token returned.
-    token_line: usize,
+    /// Line of the current item.
+    item_line: usize,
+    /// Values read so far from the current item's line.
+    found: usize,
 }
 
 impl<'a> Tokens<'a> {
-    fn next_token(&mut self) -> Option<&'a [u8]> {
-        while let Some(&b) = self.bytes.get(self.pos) {
-            if !b.is_ascii_whitespace() {
-                break;
-            }
-            if b == b'\n' {
-                self.line += 1;
-            }
+    /// Skips whitespace up to, not over, the end of the line (`\r` is whitespace).
+    fn skip_spaces(&mut self) {
+        while self.bytes.get(self.pos).is_some_and(|&b| b != b'\n' && b.is_ascii_whitespace()) {
             self.pos += 1;
         }
+    }
+
+    /// The next token on the current line, or `None` at the line's end.
+    fn next_token(&mut self) -> Option<&'a [u8]> {
+        self.skip_spaces();
         let start = self.pos;
         while self.bytes.get(self.pos).is_some_and(|b| !b.is_ascii_whitespace()) {
             self.pos += 1;
         }
-        let token = self.bytes.get(start..self.pos).filter(|t| !t.is_empty())?;
-        self.token_line = self.line;
-        Some(token)
+        self.bytes.get(start..self.pos).filter(|t| !t.is_empty())
     }
 
     fn parse<T: std::str::FromStr>(&mut self) -> Result<T, Fail> {
-        let token = self.next_token().ok_or(Fail::End)?;
+        let token = self.next_token().ok_or(Fail::Count { found: self.found })?;
+        self.found += 1;
+        // Borrows unless the token is invalid UTF-8, which is not a number anyway.
         let token = String::from_utf8_lossy(token);
         text::number(&token).map_err(Fail::Bad)
     }
@@ -65,11 +73,44 @@ impl Cursor for Tokens<'_> {
         self.parse()
     }
 
+    fn start_item(&mut self) -> Result<(), Fail> {
+        loop {
+            self.skip_spaces();
+            match self.bytes.get(self.pos) {
+                None => return Err(Fail::End),
+                Some(b'\n') => {
+                    self.pos += 1;
+                    self.line += 1;
+                }
+                Some(_) => break,
+            }
+        }
+        self.item_line = self.line;
+        self.found = 0;
+        Ok(())
+    }
+
+    fn finish_item(&mut self) -> Result<(), Fail> {
+        let mut extra = 0;
+        while self.next_token().is_some() {
+            extra += 1;
+        }
+        if extra > 0 {
+            return Err(Fail::Count { found: self.found + extra });
+        }
+        // Now at the line break, or at the end of a file whose last line has none.
+        if self.bytes.get(self.pos) == Some(&b'\n') {
+            self.pos += 1;
+            self.line += 1;
+        }
+        Ok(())
+    }
+
     fn remaining(&self) -> usize {
         self.bytes.len().saturating_sub(self.pos)
     }
 
     fn line(&self) -> Option<usize> {
-        Some(self.token_line)
+        Some(self.item_line)
     }
 }

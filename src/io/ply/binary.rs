@@ -106,9 +106,8 @@ impl Cursor for Bytes<'_> {
         ty.decode(bytes, self.big_endian).ok_or(Fail::End)
     }
 
-    fn skip_list(&mut self, count: Scalar, item: Scalar) -> Result<(), Fail> {
-        let n = items::list_length(self.number(count)?)?;
-        let size = n.checked_mul(item.size()).ok_or(Fail::End)?;
+    fn skip(&mut self, ty: Scalar, n: usize) -> Result<(), Fail> {
+        let size = n.checked_mul(ty.size()).ok_or(Fail::End)?;
         self.take(size).map(drop).ok_or(Fail::End)
     }
 

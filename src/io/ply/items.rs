@@ -1,5 +1,6 @@
 //! Reading elements item by item, property by property, from either encoding. This is the
-//! general path; binary files take a faster one for elements without lists.
+//! general path; binary files take a faster one for elements without lists. In ASCII each
+//! item is one line, so the cursor also checks that the line holds exactly the item's values.
 
 use super::header::{Element, Kind};
 use super::plan::{Job, Role, Target};
@@ -16,6 +17,9 @@ pub(crate) enum Fail {
     End,
     /// The data is malformed; the message says how.
     Bad(String),
+    /// The item's line (text only) holds `found` values, fewer or more than the item needs.
+    /// [`read_element`] turns this into a message with the expected count.
+    Count { found: usize },
 }
 
 /// A source of values: tokens of an ASCII body, or bytes of a binary one.
@@ -24,17 +28,24 @@ pub(crate) trait Cursor {
     fn coord(&mut self, ty: Scalar) -> Result<f32, Fail>;
     /// Reads any other value (counts, indices, skipped values).
     fn number(&mut self, ty: Scalar) -> Result<f64, Fail>;
-    /// Skips a whole list.
-    fn skip_list(&mut self, count: Scalar, item: Scalar) -> Result<(), Fail> {
-        let n = list_length(self.number(count)?)?;
+    /// Skips `n` values of type `ty` (the items of a list).
+    fn skip(&mut self, ty: Scalar, n: usize) -> Result<(), Fail> {
         for _ in 0..n {
-            self.number(item)?;
+            self.number(ty)?;
         }
+        Ok(())
+    }
+    /// Called before each item; a text cursor moves to the item's line.
+    fn start_item(&mut self) -> Result<(), Fail> {
+        Ok(())
+    }
+    /// Called after each item; a text cursor checks that nothing is left on its line.
+    fn finish_item(&mut self) -> Result<(), Fail> {
         Ok(())
     }
     /// Bytes not yet read.
     fn remaining(&self) -> usize;
-    /// The line of the last value read, for text; `None` for binary.
+    /// The line of the current item, for text; `None` for binary.
     fn line(&self) -> Option<usize>;
 }
 
@@ -65,10 +76,10 @@ impl Parts {
     #[inline]
     pub(crate) fn push_vertex(&mut self, c: [f32; 6]) -> Result<(), String> {
         let p = assemble::finite_position(Vec3::new(c[0], c[1], c[2]))?;
-        self.positions.push(p);
         if let Some(normals) = &mut self.normals {
-            normals.push(Vec3::new(c[3], c[4], c[5]));
+            normals.push(assemble::finite_normal(Vec3::new(c[3], c[4], c[5]))?);
         }
+        self.positions.push(p);
         Ok(())
     }
 
@@ -79,11 +90,44 @@ impl Parts {
 }
 
 /// A list length read as a number.
-pub(crate) fn list_length(value: f64) -> Result<usize, Fail> {
+fn list_length(value: f64) -> Result<usize, Fail> {
     if value >= 0.0 && value.fract() == 0.0 && value <= u32::MAX as f64 {
         Ok(value as usize)
     } else {
         Err(Fail::Bad(format!("invalid list length {value}")))
+    }
+}
+
+/// How many values one item needs, as far as is known while reading it: one per scalar, and
+/// one (the length) plus the length per list. Lists not read yet count only their length.
+#[derive(Clone, Copy)]
+struct Expected {
+    values: usize,
+    unread_lists: usize,
+}
+
+impl Expected {
+    fn new(element: &Element) -> Expected {
+        let lists = element.properties.iter().filter(|p| matches!(p.kind, Kind::List { .. })).count();
+        Expected { values: element.properties.len(), unread_lists: lists }
+    }
+
+    /// Records a list of length `n`.
+    fn list(&mut self, n: usize) {
+        self.values = self.values.saturating_add(n);
+        self.unread_lists = self.unread_lists.saturating_sub(1);
+    }
+
+    /// Replaces a [`Fail::Count`] by a message saying how many values were expected.
+    fn explain(self, fail: Fail) -> Fail {
+        match fail {
+            Fail::Count { found } => {
+                let at_least = if self.unread_lists > 0 { "at least " } else { "" };
+                let plural = if self.values == 1 { "" } else { "s" };
+                Fail::Bad(format!("expected {at_least}{} value{plural}, found {found}", self.values))
+            }
+            other => other,
+        }
     }
 }
 
@@ -106,6 +150,12 @@ pub(crate) fn error(path: &Path, line: Option<usize>, element: &Element, item: u
         ),
         (Fail::Bad(message), Some(n)) => Error::parse(path, format!("line {n}"), format!("{subject}: {message}")),
         (Fail::Bad(message), None) => Error::parse(path, subject, message),
+        // read_element explains counts; this is a fallback that names the count alone.
+        (Fail::Count { found }, line) => Error::parse(
+            path,
+            line.map_or(subject.clone(), |n| format!("line {n}")),
+            format!("{subject}: {found} values do not match the element's properties"),
+        ),
     }
 }
 
@@ -129,19 +179,27 @@ pub(crate) fn read_element<C: Cursor>(
     }
     let mut coords = [0.0f32; 6];
     let mut polygon = Vec::new();
+    let fresh = Expected::new(element);
     for item in 0..element.count {
-        read_item(cursor, element, job, parts.vertex_count, &mut coords, &mut polygon)
+        let mut expected = fresh;
+        cursor
+            .start_item()
+            .and_then(|()| {
+                read_item(cursor, element, job, parts.vertex_count, &mut coords, &mut polygon, &mut expected)
+            })
+            .and_then(|()| cursor.finish_item())
             .and_then(|()| match job.target {
                 Target::Vertices => parts.push_vertex(coords).map_err(Fail::Bad),
                 Target::Faces => assemble::push_fan(&polygon, &mut parts.triangles).map_err(Fail::Bad),
                 Target::Nothing => Ok(()),
             })
-            .map_err(|fail| error(path, cursor.line(), element, item, fail))?;
+            .map_err(|fail| error(path, cursor.line(), element, item, expected.explain(fail)))?;
     }
     Ok(())
 }
 
-/// Reads one item's properties into `coords` and `polygon`.
+/// Reads one item's properties into `coords` and `polygon`, counting list lengths into
+/// `expected` as they are read.
 fn read_item<C: Cursor>(
     cursor: &mut C,
     element: &Element,
@@ -149,6 +207,7 @@ fn read_item<C: Cursor>(
     vertex_count: usize,
     coords: &mut [f32; 6],
     polygon: &mut Vec<u32>,
+    expected: &mut Expected,
 ) -> Result<(), Fail> {
     polygon.clear();
     for (property, role) in element.properties.iter().zip(&job.roles) {
@@ -161,13 +220,17 @@ fn read_item<C: Cursor>(
             (Kind::Scalar(ty), _) => {
                 cursor.number(ty)?;
             }
-            (Kind::List { count, item }, Role::Indices) => {
+            (Kind::List { count, item }, role) => {
                 let n = list_length(cursor.number(count)?)?;
-                for _ in 0..n {
-                    polygon.push(index(cursor.number(item)?, vertex_count)?);
+                expected.list(n);
+                if role == Role::Indices {
+                    for _ in 0..n {
+                        polygon.push(index(cursor.number(item)?, vertex_count)?);
+                    }
+                } else {
+                    cursor.skip(item, n)?;
                 }
             }
-            (Kind::List { count, item }, _) => cursor.skip_list(count, item)?,
         }
     }
     Ok(())

@@ -3,8 +3,9 @@
 //! The reader takes positions from the `vertex` element's `x y z`, normals from `nx ny nz`
 //! when all three are present, and polygons from the `face` element's `vertex_indices` (or
 //! `vertex_index`) list, fan-triangulated. Every other element and property is skipped.
-//! Errors name the header or body line (ASCII), or the element item (binary, numbered from 0,
-//! e.g. `face 3`).
+//! Positions and normals must be finite. In ASCII bodies each item is one line (blank lines
+//! between items are skipped). Errors name the header or body line (ASCII), or the element
+//! item (binary, numbered from 0, e.g. `face 3`).
 
 mod ascii;
 mod binary;
