@@ -288,11 +288,7 @@ fn run(command: Command) -> vstree::Result<()> {
             tree_params.check()?; // before reading what may be a large file
             check_output(&input, &output)?;
             let (mesh, read_s) = timed(|| read_with_normals(&input, tree.threads, tree.quiet))?;
-            let params = SimplifyParams {
-                tree: tree_params,
-                sampling: sampling.into(),
-                threads: tree.threads,
-            };
+            let params = SimplifyParams { tree: tree_params, sampling: sampling.into(), threads: tree.threads };
             let (out, stats) = with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
             let (_, write_s) = timed(|| io::write_with(&output, &out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
