@@ -12,6 +12,7 @@
 //! what a brute-force scan with the same ordering returns.
 
 use crate::error::{Error, Result};
+use crate::mesh::check_positions;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -148,15 +149,13 @@ impl Best {
 impl KdTree {
     /// Builds the tree over `points` (in parallel on the current rayon pool).
     ///
-    /// Errors: a point with a NaN or infinite coordinate (named), or more than `u32::MAX - 1`
-    /// points.
+    /// Errors: a point with a NaN, infinite or out-of-range coordinate (named, see
+    /// [`check_positions`]), or more than `u32::MAX - 1` points.
     pub fn new(points: &[Vec3]) -> Result<KdTree> {
         if points.len() >= u32::MAX as usize {
             return Err(Error::TooLarge(format!("{} points (at most {})", points.len(), u32::MAX - 1)));
         }
-        if let Some(i) = points.par_iter().position_first(|p| !p.is_finite()) {
-            return Err(Error::input(format!("point {i} has a NaN or infinite coordinate")));
-        }
+        check_positions(points, "point")?;
         let mut entries: Vec<Entry> =
             points.par_iter().enumerate().map(|(i, p)| Entry { p: p.to_array(), id: i as u32 }).collect();
         let levels = inner_levels(entries.len());

@@ -15,6 +15,29 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
 }
 
+/// Largest coordinate magnitude accepted. The geometry is `f32`: squared lengths of
+/// coordinate differences must stay finite (below 3.4e38), with room for sums of them.
+pub const MAX_COORDINATE: f32 = 1e18;
+
+/// Checks that every point is finite and within [`MAX_COORDINATE`]; the error names the first
+/// offender as `{what} {index}` (e.g. "vertex 12").
+pub fn check_positions(points: &[Vec3], what: &str) -> Result<()> {
+    // (`max_element` skips NaN, so finiteness is tested on its own.)
+    let Some(i) = points.iter().position(|p| !p.is_finite() || p.abs().max_element() > MAX_COORDINATE) else {
+        return Ok(());
+    };
+    let p = points[i];
+    Err(Error::input(if p.is_finite() {
+        format!(
+            "{what} {i} has a coordinate of {:e}: at most {MAX_COORDINATE:e} in magnitude is supported \
+             (32-bit geometry); rescale the input",
+            p.abs().max_element()
+        )
+    } else {
+        format!("{what} {i} has a NaN or infinite coordinate")
+    }))
+}
+
 /// An axis-aligned bounding box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
@@ -30,9 +53,10 @@ impl Aabb {
         Some(Aabb { min, max })
     }
 
-    /// Length of the diagonal: the unit all relative thresholds are measured in.
+    /// Length of the diagonal: the unit all relative thresholds are measured in. Computed in
+    /// `f64`, so neither very large nor very small boxes overflow or underflow on the way.
     pub fn diagonal(&self) -> f32 {
-        (self.max - self.min).length()
+        (self.max.as_dvec3() - self.min.as_dvec3()).length() as f32
     }
 
     pub fn center(&self) -> Vec3 {
@@ -54,12 +78,10 @@ impl Mesh {
         Aabb::of(&self.positions)
     }
 
-    /// Checks what every algorithm relies on: finite coordinates, normals (if any) as many as
+    /// Checks what every algorithm relies on: finite coordinates within [`MAX_COORDINATE`], normals (if any) as many as
     /// positions and finite, triangle indices in range. The error names the first offender.
     pub fn check(&self) -> Result<()> {
-        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
-            return Err(Error::input(format!("vertex {i} has a NaN or infinite coordinate")));
-        }
+        check_positions(&self.positions, "vertex")?;
         if let Some(normals) = &self.normals {
             if normals.len() != self.positions.len() {
                 return Err(Error::input(format!("{} normals for {} vertices", normals.len(), self.positions.len())));

@@ -22,7 +22,7 @@
 use crate::error::{Error, Result};
 use crate::knn::KdTree;
 use crate::linalg::Sym3;
-use crate::mesh::Mesh;
+use crate::mesh::{check_positions, Mesh};
 use crate::progress::{Progress, Threads};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -249,9 +249,7 @@ fn prepare(points: &[Vec3], params: &NormalParams) -> Result<Threads> {
     if points.len() < 3 {
         return Err(Error::input(format!("{} points: normals need at least 3", points.len())));
     }
-    if let Some(i) = points.iter().position(|p| !p.is_finite()) {
-        return Err(Error::input(format!("point {i} has a NaN or infinite coordinate")));
-    }
+    check_positions(points, "point")?;
     Threads::new(params.threads)
 }
 

@@ -75,7 +75,26 @@ fn representative(tree: &VsTree, leaf: usize, origin: DVec3) -> (Vec3, Vec3) {
     }
     let frame = (node.kind == NodeKind::Surface).then(|| &tree.frames[node.frame as usize]);
     let x = tree::representative(node, frame, &stats, origin);
-    (x.as_vec3(), stats.mean_normal().normalize_or_zero().as_vec3())
+    let first = tree.samples_of(node).first().map_or(Vec3::Z, |s| s.normal);
+    (x.as_vec3(), cluster_normal(&stats, first))
+}
+
+/// The cluster's unit normal: its samples' mean normal. Where the normals cancel out (two
+/// sheets facing away from each other in one cell), the mean says nothing; the axis the
+/// normals share most (the main eigenvector of Σ n nᵀ) is used instead, turned towards
+/// `first`, a sample's normal, so that no cluster gets a zero normal.
+fn cluster_normal(stats: &CellStats, first: Vec3) -> Vec3 {
+    let mean = stats.mean_normal();
+    if mean.length() > 1e-6 {
+        return mean.normalize().as_vec3();
+    }
+    let (_, vectors) = stats.nn.eigen();
+    let axis = vectors[0].as_vec3().normalize_or(Vec3::Z);
+    if axis.dot(first) < 0.0 {
+        -axis
+    } else {
+        axis
+    }
 }
 
 /// The samples, tree and clusters of a mesh (or a point cloud with normals): the steps

@@ -69,6 +69,33 @@ fn non_finite_values_are_refused_by_index() {
 }
 
 #[test]
+fn huge_and_tiny_coordinates() {
+    // Beyond 1e18 the squares of 32-bit coordinates overflow: refused, naming the vertex.
+    let far = |d: f32| cloud(&[Vec3::ZERO, Vec3::X * d, Vec3::Y * d, Vec3::Z * d]);
+    let e = message(simplify_default(&far(1e20)));
+    assert!(e.contains("vertex 1") && e.contains("rescale"), "{e}");
+    // Within range the relative bound still means what it says: four points far apart, three
+    // on the plane z = 0 and one above it (all normals +z), stay four clusters on a tight
+    // bound. (At 1e-25 the diagonal, once computed in f32, underflowed to zero.)
+    for d in [1e17, 1e-25] {
+        let tight = TreeParams { error: 1e-9, ..TreeParams::default() };
+        let (out, stats) = simplify_with(&far(d), tight).unwrap();
+        assert_eq!((stats.tree.leaves, out.positions.len()), (4, 4), "spacing {d}");
+    }
+}
+
+#[test]
+fn normals_that_cancel_out_give_a_cluster_a_unit_normal() {
+    // Two sheets facing away from each other in one cluster: the mean normal is zero.
+    let mut c = cloud(&[Vec3::ZERO, Vec3::X]);
+    c.normals = Some(vec![Vec3::Z, -Vec3::Z]);
+    let (out, stats) = simplify_with(&c, TreeParams { error: 10.0, ..TreeParams::default() }).unwrap();
+    assert_eq!(stats.tree.leaves, 1);
+    let n = out.normals.unwrap()[0];
+    assert!((n.length() - 1.0).abs() < 1e-6 && n.z.abs() > 0.999, "{n}");
+}
+
+#[test]
 fn zero_normals_in_a_cloud_are_refused() {
     let mut c = cloud(&[Vec3::ZERO, Vec3::X]);
     c.normals.as_mut().unwrap()[0] = Vec3::ZERO;

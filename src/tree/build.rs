@@ -12,7 +12,7 @@ use super::indicator::{frame, is_height_field, reach};
 use super::partition::partition;
 use super::{representative, Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
 use crate::error::{Error, Result};
-use crate::mesh::Aabb;
+use crate::mesh::{check_positions, Aabb};
 use crate::progress::{Progress, Threads};
 use crate::quadric::CellStats;
 use crate::samples::SampleSet;
@@ -36,8 +36,10 @@ pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progre
     let diagonal = bounds.diagonal();
     let extent = (bounds.max - bounds.min).max_element();
     let center = bounds.center();
-    // Enlarged a little so no sample sits exactly on the root's border; never zero.
-    let half = 0.5 * extent * (1.0 + 1e-4) + 1e-6 * (1.0 + center.abs().max_element());
+    // Enlarged a little so no sample sits exactly on the root's border (by more than the f32
+    // rounding of the coordinates), in proportion to the input's own scale so that the tree
+    // does not depend on units; never zero.
+    let half = 0.5 * extent * (1.0 + 1e-4) + 1e-6 * (extent + center.abs().max_element()) + 1e-30;
     let builder = Builder {
         params: *params,
         origin: center.as_dvec3(),
@@ -132,9 +134,7 @@ fn check_samples(samples: &SampleSet) -> Result<()> {
     if samples.len() >= u32::MAX as usize {
         return Err(Error::TooLarge(format!("{} samples (at most {})", samples.len(), u32::MAX - 1)));
     }
-    if let Some(i) = samples.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::input(format!("sample {i} has a NaN or infinite coordinate")));
-    }
+    check_positions(&samples.positions, "sample")?;
     if let Some(i) = samples.normals.iter().position(|n| !n.is_finite()) {
         return Err(Error::input(format!("sample {i} has a NaN or infinite normal")));
     }

@@ -81,9 +81,10 @@ pub(super) fn frame(samples: &[TreeSample], stats: &CellStats, origin: DVec3) ->
         hi = hi.max(q);
     }
     frame.square_center = 0.5 * (lo + hi);
-    // Slightly enlarged so samples on the border are inside; never zero.
+    // Slightly enlarged so samples on the border are inside, in proportion to the cell's own
+    // scale (not the units'); never zero.
     let half = 0.5 * (hi - lo).max_element();
-    frame.square_half = half * (1.0 + 1e-4) + 1e-7 * (1.0 + frame.square_center.abs().max_element());
+    frame.square_half = half * (1.0 + 1e-4) + 1e-7 * (half + frame.square_center.abs().max_element()) + 1e-30;
     frame
 }
 
