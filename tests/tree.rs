@@ -18,10 +18,7 @@ fn params(kind: TreeKind, error: f64) -> TreeParams {
 #[test]
 fn invariants_hold_on_every_real_model() {
     for (name, mesh) in common::all_models() {
-        let Some(samples) = common::samples_of(&mesh) else {
-            eprintln!("{name}: a cloud without normals (needs normal estimation), skipped");
-            continue;
-        };
+        let samples = common::samples_of(&mesh);
         for kind in [TreeKind::VsTree, TreeKind::Octree] {
             for error in [1e-4, 2e-3] {
                 let t = build(&samples, &params(kind, error), 0);
@@ -111,7 +108,7 @@ fn fewer_clusters_than_the_octree_on_real_scans() {
         let Some(mesh) = common::load(name) else {
             return;
         };
-        let samples = common::samples_of(&mesh).unwrap();
+        let samples = common::samples_of(&mesh);
         for error in [1e-4, 2e-3] {
             let vs = build(&samples, &params(TreeKind::VsTree, error), 0).stats().leaves;
             let oct = build(&samples, &params(TreeKind::Octree, error), 0).stats().leaves;
@@ -177,4 +174,64 @@ fn locate_finds_the_leaf_of_every_sample() {
         }
     }
     assert_eq!(t.locate(glam::Vec3::splat(100.0)), None);
+}
+
+/// A valid tree to break, with a T-layer and quadtrees below it.
+fn sphere_tree() -> vstree::VsTree {
+    let t = build(&unit_sphere_samples(20_000), &params(TreeKind::VsTree, 1e-5), 0);
+    t.validate().unwrap();
+    assert!(t.stats().s_nodes > 0);
+    t
+}
+
+/// Breaks a copy of a valid tree with `corrupt` and checks that `validate` names the fault.
+fn fails_with(corrupt: impl Fn(&mut vstree::VsTree), expected: &str) {
+    let mut t = sphere_tree();
+    corrupt(&mut t);
+    let e = t.validate().expect_err("a broken tree passed validate()");
+    assert!(e.contains(expected), "expected {expected:?} in {e:?}");
+}
+
+#[test]
+fn validate_finds_every_kind_of_fault() {
+    let first_leaf = |t: &vstree::VsTree| t.leaves().next().unwrap();
+    let first_of = |t: &vstree::VsTree, kind| t.nodes.iter().position(|n| n.kind == kind && !n.is_leaf()).unwrap();
+    // A sample listed twice (and another missing).
+    fails_with(|t| t.samples[1].index = t.samples[0].index, "repeated");
+    // A sample moved out of its leaf's cell.
+    fails_with(
+        |t| {
+            let leaf = first_leaf(t);
+            let start = t.nodes[leaf].start as usize;
+            t.samples[start].position += glam::Vec3::splat(0.5);
+        },
+        "outside",
+    );
+    // A frame that is not orthonormal.
+    fails_with(|t| t.frames[0].u *= 2.0, "not orthonormal");
+    // A volume cell below a T-node (the 3D/2D boundary crossed twice).
+    fails_with(
+        |t| {
+            let c = t.nodes[first_of(t, NodeKind::Transition)].first_child as usize;
+            t.nodes[c].kind = NodeKind::Volume;
+            t.nodes[c].frame = vstree::tree::NO_FRAME;
+        },
+        "Volume child",
+    );
+    // A child cell larger than its parent.
+    fails_with(
+        |t| {
+            let c = t.nodes[first_of(t, NodeKind::Volume)].first_child as usize;
+            t.nodes[c].half *= 4.0;
+        },
+        "sub-cell",
+    );
+    // Children whose sample ranges do not tile their parent's.
+    fails_with(
+        |t| {
+            let c = t.nodes[first_of(t, NodeKind::Surface)].first_child as usize;
+            t.nodes[c].count -= 1;
+        },
+        "start",
+    );
 }

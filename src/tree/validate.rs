@@ -24,6 +24,17 @@ impl VsTree {
                 return Err(format!("sample index {i} out of range or repeated"));
             }
         }
+        // Frames first: the nodes' checks project samples with them.
+        for (i, f) in self.frames.iter().enumerate() {
+            let ok = [f.normal, f.u, f.v].iter().all(|a| (a.length() - 1.0).abs() < 1e-4)
+                && f.normal.dot(f.u).abs() < 1e-4
+                && f.normal.dot(f.v).abs() < 1e-4
+                && f.u.dot(f.v).abs() < 1e-4
+                && f.square_half > 0.0;
+            if !ok {
+                return Err(format!("frame {i} is not orthonormal: {f:?}"));
+            }
+        }
         let mut covered = vec![0u8; n];
         for (i, node) in self.nodes.iter().enumerate() {
             self.check_node(i).map_err(|e| format!("node {i} ({:?}, depth {}): {e}", node.kind, node.depth))?;
@@ -35,16 +46,6 @@ impl VsTree {
         }
         if let Some(i) = covered.iter().position(|&c| c != 1) {
             return Err(format!("sample {i} is in {} leaves", covered[i]));
-        }
-        for (i, f) in self.frames.iter().enumerate() {
-            let ok = [f.normal, f.u, f.v].iter().all(|a| (a.length() - 1.0).abs() < 1e-4)
-                && f.normal.dot(f.u).abs() < 1e-4
-                && f.normal.dot(f.v).abs() < 1e-4
-                && f.u.dot(f.v).abs() < 1e-4
-                && f.square_half > 0.0;
-            if !ok {
-                return Err(format!("frame {i} is not orthonormal: {f:?}"));
-            }
         }
         Ok(())
     }

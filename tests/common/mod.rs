@@ -38,12 +38,15 @@ pub fn all_models() -> Vec<(String, Mesh)> {
     names.into_iter().map(|n| (n.clone(), load(&n).unwrap())).collect()
 }
 
-/// The samples the library would use: mesh vertices, or the cloud's points when it has normals.
-pub fn samples_of(mesh: &Mesh) -> Option<SampleSet> {
+/// The samples the library would use: mesh vertices, or the cloud's points with their normals
+/// (estimated when the cloud has none).
+pub fn samples_of(mesh: &Mesh) -> SampleSet {
     if mesh.is_point_cloud() {
-        mesh.normals.as_ref()?;
-        Some(SampleSet::from_cloud(mesh).unwrap())
+        let mut cloud = mesh.clone();
+        // Clouds without normals (raw scans) get them estimated, as `vstree stats` does.
+        vstree::normals::ensure_normals(&mut cloud, &Default::default(), &mut vstree::Progress::none()).unwrap();
+        SampleSet::from_cloud(&cloud).unwrap()
     } else {
-        Some(SampleSet::from_mesh(mesh, MeshSampling::Vertices).unwrap())
+        SampleSet::from_mesh(mesh, MeshSampling::Vertices).unwrap()
     }
 }
