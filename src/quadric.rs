@@ -91,6 +91,12 @@ impl CellStats {
     /// The L2,1 error (Cohen-Steiner, Alliez, Desbrun 2004): the mean of ‖nⱼ − n̂‖² over the
     /// samples, n̂ the normalised average normal. For unit normals that is 2(1 − ‖mean n‖):
     /// 0 for a flat cell, up to 4 for opposing normals. Unitless.
+    ///
+    /// Cohen-Steiner et al. weight each term by its area. Here every sample weighs the same,
+    /// which is that weighting when the samples are spread evenly over the surface (clouds
+    /// drawn by area, the vertices of an even mesh): point clouds carry no areas, and one
+    /// weight per sample would cost every metric memory and time. On meshes with very uneven
+    /// triangles, face-centre sampling with a fine bound comes closer.
     pub fn normal_deviation(&self) -> f64 {
         if self.count == 0 {
             return 0.0;
