@@ -235,3 +235,26 @@ fn validate_finds_every_kind_of_fault() {
         "start",
     );
 }
+
+#[test]
+fn the_tree_does_not_depend_on_units() {
+    // Bounds are relative to the diagonal, so the same shape in metres or micrometres, here or
+    // far from the origin, gives the same clusters (up to the rounding of 32-bit coordinates).
+    let base = unit_sphere_samples(50_000);
+    let counts: Vec<(f32, usize)> = [1e-9f32, 1e-3, 1.0, 1e4, 1e9]
+        .iter()
+        .map(|&scale| {
+            let mut s = base.clone();
+            for p in &mut s.positions {
+                *p = *p * scale + glam::Vec3::new(3.0, -2.0, 1.0) * scale;
+            }
+            let t = build(&s, &params(TreeKind::VsTree, 1e-5), 0);
+            t.validate().unwrap();
+            (scale, t.stats().leaves)
+        })
+        .collect();
+    let unit = counts[2].1 as f64;
+    for (scale, leaves) in &counts {
+        assert!((*leaves as f64 / unit - 1.0).abs() < 0.01, "scale {scale}: {leaves} clusters, {unit} at scale 1");
+    }
+}
