@@ -17,6 +17,17 @@ fn parse_error(result: Result<Mesh>, file: &str) -> (String, String) {
     }
 }
 
+/// Checks an error's location, and that its message contains `needle`.
+fn expect_at((location, message): (String, String), expected: &str, needle: &str) {
+    assert_eq!(location, expected, "{message}");
+    assert!(message.contains(needle), "{needle:?} not in {message:?}");
+}
+
+/// An expected error: its location and message.
+fn at(location: &str, message: &str) -> (String, String) {
+    (location.to_string(), message.to_string())
+}
+
 fn ply(src: &[u8]) -> (String, String) {
     parse_error(io::ply::parse(src, Path::new("bad.ply")), "bad.ply")
 }
@@ -62,28 +73,20 @@ fn ascii_ply(body: &str) -> Vec<u8> {
 fn truncated_binary_ply_names_the_item() {
     let good = binary_triangles([[0, 1, 2], [2, 1, 0]], 0.0);
     io::ply::parse(&good, Path::new("bad.ply")).unwrap();
-    let (location, message) = ply(&good[..good.len() - 2]);
-    assert_eq!(location, "face 1");
-    assert!(message.contains("file ends in face 1 of 2"), "{message}");
-    let (location, message) = ply(&good[..TRIANGLE_HEADER.len() + 13]);
-    assert_eq!(location, "vertex 1");
-    assert!(message.contains("file ends in vertex 1 of 3"), "{message}");
+    expect_at(ply(&good[..good.len() - 2]), "face 1", "file ends in face 1 of 2");
+    expect_at(ply(&good[..TRIANGLE_HEADER.len() + 13]), "vertex 1", "file ends in vertex 1 of 3");
 }
 
 #[test]
 fn bad_magic_and_header_errors_name_the_line() {
-    let (location, message) = ply(b"PLY\nformat ascii 1.0\nend_header\n");
-    assert_eq!(location, "line 1");
-    assert!(message.contains("not a PLY file"), "{message}");
-    let (location, message) = ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n");
-    assert_eq!(location, "line 4");
-    assert!(message.contains("unknown property type `float128`"), "{message}");
-    let (location, message) = ply(b"ply\nformat binary_middle_endian 1.0\nend_header\n");
-    assert_eq!(location, "line 2");
-    assert!(message.contains("unknown format"), "{message}");
-    let (location, message) = ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n");
-    assert_eq!(location, "line 3");
-    assert!(message.contains("`y`"), "{message}");
+    expect_at(ply(b"PLY\nformat ascii 1.0\nend_header\n"), "line 1", "not a PLY file");
+    expect_at(
+        ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n"),
+        "line 4",
+        "unknown property type `float128`",
+    );
+    expect_at(ply(b"ply\nformat binary_middle_endian 1.0\nend_header\n"), "line 2", "unknown format");
+    expect_at(ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n0\n"), "line 3", "`y`");
 }
 
 #[test]
@@ -91,9 +94,7 @@ fn out_of_range_face_index_names_the_face() {
     let (location, message) = ply(&binary_triangles([[0, 1, 2], [0, 1, 99]], 0.0));
     assert_eq!(location, "face 1");
     assert!(message.contains("vertex 99") && message.contains("only 3 vertices"), "{message}");
-    let (location, message) = ply(&binary_triangles([[0, -1, 2], [0, 1, 2]], 0.0));
-    assert_eq!(location, "face 0");
-    assert!(message.contains("-1"), "{message}");
+    expect_at(ply(&binary_triangles([[0, -1, 2], [0, 1, 2]], 0.0)), "face 0", "-1");
     let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"));
     assert_eq!(location, "line 13");
     assert!(message.contains("face 0") && message.contains("vertex 3"), "{message}");
@@ -118,22 +119,14 @@ fn non_numeric_tokens_name_the_line() {
     let (location, message) = ply(&ascii_ply("0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n"));
     assert_eq!(location, "line 11");
     assert!(message.contains("vertex 1") && message.contains("`zero`"), "{message}");
-    let (location, message) = off("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 q\n3 0 1 2\n");
-    assert_eq!(location, "line 5");
-    assert!(message.contains("`q`"), "{message}");
-    let (location, message) = off("OFF\nthree 1 0\n");
-    assert_eq!(location, "line 2");
-    assert!(message.contains("`three`"), "{message}");
-    let (location, message) = xyz("0 0 0\n1 1 1\n2 2 two\n");
-    assert_eq!(location, "line 3");
-    assert!(message.contains("`two`"), "{message}");
+    expect_at(off("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 q\n3 0 1 2\n"), "line 5", "`q`");
+    expect_at(off("OFF\nthree 1 0\n"), "line 2", "`three`");
+    expect_at(xyz("0 0 0\n1 1 1\n2 2 two\n"), "line 3", "`two`");
 }
 
 #[test]
 fn inconsistent_xyz_columns_name_the_line() {
-    let (location, message) = xyz("# points\n0 0 0 0 0 1\n1 1 1 0 0 1\n2 2 2\n");
-    assert_eq!(location, "line 4");
-    assert!(message.contains("expected 6 numbers like line 2, found 3"), "{message}");
+    expect_at(xyz("# points\n0 0 0 0 0 1\n1 1 1 0 0 1\n2 2 2\n"), "line 4", "expected 6 numbers like line 2, found 3");
 }
 
 #[test]
@@ -143,15 +136,11 @@ fn absurd_counts_in_tiny_files_fail_fast() {
         property float x\nproperty float y\nproperty float z\nend_header\n"
         .to_vec();
     huge.extend_from_slice(&[0; 100]);
-    let (location, message) = ply(&huge);
-    assert_eq!(location, "vertex 8");
-    assert!(message.contains("of 2147483648"), "{message}");
+    expect_at(ply(&huge), "vertex 8", "of 2147483648");
     let ascii = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
         property float z\nelement face 18446744073709551615\nproperty list uint uint vertex_indices\n\
         end_header\n0 0 0\n0 0 0\n0 0 0\n4294967295 0 1 2\n";
-    let (location, message) = ply(ascii);
-    assert_eq!(location, "line 13");
-    assert!(message.contains("face 0: expected 4294967296 values, found 4"), "{message}");
+    expect_at(ply(ascii), "line 13", "face 0: expected 4294967296 values, found 4");
     let (_, message) = off("OFF\n4000000000 4000000000 0\n0 0 0\n");
     assert!(message.contains("file ends in vertex 1 of 4000000000"), "{message}");
     // Elements without properties occupy no bytes, whatever their count.
@@ -178,18 +167,10 @@ fn empty_files_are_errors() {
 
 #[test]
 fn nan_coordinates_name_the_vertex() {
-    let (location, message) = ply(&binary_triangles([[0, 1, 2], [2, 1, 0]], f32::NAN));
-    assert_eq!(location, "vertex 0");
-    assert!(message.contains("NaN"), "{message}");
-    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 inf\n0 1 0\n3 0 1 2\n"));
-    assert_eq!(location, "line 11");
-    assert!(message.contains("vertex 1"), "{message}");
-    let (location, message) = off("OFF\n3 1 0\n0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n");
-    assert_eq!(location, "line 5");
-    assert!(message.contains("vertex 2"), "{message}");
-    let (location, message) = xyz("0 0 0\nNaN 0 0\n");
-    assert_eq!(location, "line 2");
-    assert!(message.contains("point 1"), "{message}");
+    expect_at(ply(&binary_triangles([[0, 1, 2], [2, 1, 0]], f32::NAN)), "vertex 0", "NaN");
+    expect_at(ply(&ascii_ply("0 0 0\n1 0 inf\n0 1 0\n3 0 1 2\n")), "line 11", "vertex 1");
+    expect_at(off("OFF\n3 1 0\n0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n"), "line 5", "vertex 2");
+    expect_at(xyz("0 0 0\nNaN 0 0\n"), "line 2", "point 1");
     let obj = io::obj::parse(b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Path::new("bad.obj"));
     parse_error(obj, "bad.obj");
 }
@@ -224,29 +205,35 @@ fn obj(src: &str) -> (String, String) {
 
 #[test]
 fn non_finite_normals_name_the_line_or_element() {
-    let (location, message) = ply(&binary_ply_with_normals(2, [0.0, f32::NAN, 1.0]));
-    assert_eq!(location, "vertex 2");
-    assert!(message.contains("NaN or infinite normal component (0, NaN, 1)"), "{message}");
-    let (location, message) = ply(&binary_ply_with_normals(0, [f32::NEG_INFINITY, 0.0, 0.0]));
-    assert_eq!(location, "vertex 0");
-    assert!(message.contains("normal component (-inf, 0, 0)"), "{message}");
-    let (location, message) = ply(&ascii_ply_with_normals(3, "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 nan 0 1\n"));
-    assert_eq!(location, "line 13");
-    assert!(message.contains("vertex 2: has a NaN or infinite normal component"), "{message}");
-    let (location, message) = xyz("# n\n0 0 0 0 0 1\n1 1 1 0 inf 1\n");
-    assert_eq!(location, "line 3");
-    assert!(message.contains("point 1: has a NaN or infinite normal component (0, inf, 1)"), "{message}");
-    let (location, message) = off("NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 NaN\n0 1 0 0 0 1\n3 0 1 2\n");
-    assert_eq!(location, "line 4");
-    assert!(message.contains("vertex 1: has a NaN or infinite normal component"), "{message}");
+    expect_at(
+        ply(&binary_ply_with_normals(2, [0.0, f32::NAN, 1.0])),
+        "vertex 2",
+        "NaN or infinite normal component (0, NaN, 1)",
+    );
+    expect_at(
+        ply(&binary_ply_with_normals(0, [f32::NEG_INFINITY, 0.0, 0.0])),
+        "vertex 0",
+        "normal component (-inf, 0, 0)",
+    );
+    expect_at(
+        ply(&ascii_ply_with_normals(3, "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 nan 0 1\n")),
+        "line 13",
+        "vertex 2: has a NaN or infinite normal component",
+    );
+    expect_at(
+        xyz("# n\n0 0 0 0 0 1\n1 1 1 0 inf 1\n"),
+        "line 3",
+        "point 1: has a NaN or infinite normal component (0, inf, 1)",
+    );
+    expect_at(
+        off("NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 NaN\n0 1 0 0 0 1\n3 0 1 2\n"),
+        "line 4",
+        "vertex 1: has a NaN or infinite normal component",
+    );
     // OBJ per-vertex normals (kept) name their `vn` line, though tobj renumbers vertices.
     let src = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\nvn nan 0 1\nf 3//3 2//2 1//1\n";
-    let (location, message) = obj(src);
-    assert_eq!(location, "line 6");
-    assert!(message.contains("normal 2 has a NaN or infinite normal component"), "{message}");
-    let (location, message) = obj("v 0 0 0\nv 1 0 0\nvn 0 0 1\nvn 0 inf 0\n");
-    assert_eq!(location, "line 4");
-    assert!(message.contains("normal 1 has a NaN"), "{message}");
+    expect_at(obj(src), "line 6", "normal 2 has a NaN or infinite normal component");
+    expect_at(obj("v 0 0 0\nv 1 0 0\nvn 0 0 1\nvn 0 inf 0\n"), "line 4", "normal 1 has a NaN");
 }
 
 #[test]
@@ -264,33 +251,25 @@ fn dropped_or_zero_normals_are_not_reader_errors() {
 
 #[test]
 fn ascii_ply_items_end_at_their_line() {
-    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n"));
-    assert_eq!(location, "line 11");
-    assert_eq!(message, "vertex 1: expected 3 values, found 4");
-    let (location, message) = ply(&ascii_ply("0 0 0\n1 0\n0 1 0\n3 0 1 2\n"));
-    assert_eq!(location, "line 11");
-    assert_eq!(message, "vertex 1: expected 3 values, found 2");
-    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1\n"));
-    assert_eq!(location, "line 13");
-    assert_eq!(message, "face 0: expected 4 values, found 3");
-    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1 2 1\n"));
-    assert_eq!(location, "line 13");
-    assert_eq!(message, "face 0: expected 4 values, found 5");
+    assert_eq!(
+        ply(&ascii_ply("0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n")),
+        at("line 11", "vertex 1: expected 3 values, found 4")
+    );
+    assert_eq!(ply(&ascii_ply("0 0 0\n1 0\n0 1 0\n3 0 1 2\n")), at("line 11", "vertex 1: expected 3 values, found 2"));
+    assert_eq!(ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1\n")), at("line 13", "face 0: expected 4 values, found 3"));
+    assert_eq!(
+        ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1 2 1\n")),
+        at("line 13", "face 0: expected 4 values, found 5")
+    );
     let body = "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n1 1 0 0 0 1 5\n";
-    let (location, message) = ply(&ascii_ply_with_normals(4, body));
-    assert_eq!(location, "line 14");
-    assert_eq!(message, "vertex 3: expected 6 values, found 7");
+    assert_eq!(ply(&ascii_ply_with_normals(4, body)), at("line 14", "vertex 3: expected 6 values, found 7"));
     // A list not read yet counts only its length: the expected count is a lower bound.
     let two_lists = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
         property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
         property list uchar float texcoord\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n";
-    let (location, message) = ply(two_lists);
-    assert_eq!(location, "line 14");
-    assert_eq!(message, "face 0: expected at least 5 values, found 3");
+    assert_eq!(ply(two_lists), at("line 14", "face 0: expected at least 5 values, found 3"));
     // A vertex line missing from the middle is reported where the items stop matching.
-    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n3 0 1 2\n"));
-    assert_eq!(location, "line 12");
-    assert_eq!(message, "vertex 2: expected 3 values, found 4");
+    assert_eq!(ply(&ascii_ply("0 0 0\n1 0 0\n3 0 1 2\n")), at("line 12", "vertex 2: expected 3 values, found 4"));
 }
 
 #[test]
@@ -301,52 +280,46 @@ fn ascii_ply_tolerates_blank_lines_trailing_spaces_and_crlf() {
     let mesh = io::ply::parse(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n3 0 1 2"), Path::new("ok.ply")).unwrap();
     assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
     // Skipped blank lines still count for the line numbers.
-    let (location, message) = ply(&ascii_ply("0 0 0\n\n\r\n1 0 0 5\n0 1 0\n3 0 1 2\n"));
-    assert_eq!(location, "line 13");
-    assert_eq!(message, "vertex 1: expected 3 values, found 4");
-    let (location, message) = ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n\n\n"));
-    assert_eq!(location, "line 12");
-    assert_eq!(message, "file ends in face 0 of 1");
+    assert_eq!(
+        ply(&ascii_ply("0 0 0\n\n\r\n1 0 0 5\n0 1 0\n3 0 1 2\n")),
+        at("line 13", "vertex 1: expected 3 values, found 4")
+    );
+    assert_eq!(ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n\n\n")), at("line 12", "file ends in face 0 of 1"));
 }
 
 #[test]
 fn obj_errors_name_the_line() {
     let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
-    let (location, message) = obj(&format!("{tri}f 1 2 3\nf 1 2 9\n"));
-    assert_eq!(location, "line 5");
-    assert!(message.contains("vertex index 9 is out of range: the file has 3 `v` lines"), "{message}");
-    let (location, message) = obj(&format!("{tri}f 0 1 2\n"));
-    assert_eq!(location, "line 4");
-    assert!(message.contains("vertex index 0 is invalid"), "{message}");
+    expect_at(
+        obj(&format!("{tri}f 1 2 3\nf 1 2 9\n")),
+        "line 5",
+        "vertex index 9 is out of range: the file has 3 `v` lines",
+    );
+    expect_at(obj(&format!("{tri}f 0 1 2\n")), "line 4", "vertex index 0 is invalid");
     let (location, message) = obj("# relative\nv 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n");
     assert_eq!(location, "line 4");
     assert!(message.contains("relative vertex index -3") && message.contains("only 2 `v` lines"), "{message}");
-    let (location, message) = obj("v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n");
-    assert_eq!(location, "line 3");
-    assert!(message.contains("`zero`"), "{message}");
-    let (location, message) = obj(&format!("{tri}vn 0 0 1\nf 1//1 2//1 3//2\n"));
-    assert_eq!(location, "line 5");
-    assert!(message.contains("normal index 2 is out of range"), "{message}");
-    let (location, message) = obj(&format!("{tri}f 1 2/x 3\n"));
-    assert_eq!(location, "line 4");
-    assert!(message.contains("`2/x`"), "{message}");
+    expect_at(obj("v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n"), "line 3", "`zero`");
+    expect_at(obj(&format!("{tri}vn 0 0 1\nf 1//1 2//1 3//2\n")), "line 5", "normal index 2 is out of range");
+    expect_at(obj(&format!("{tri}f 1 2/x 3\n")), "line 4", "`2/x`");
     // Makes tobj index out of bounds (a panic it does not guard against): still located.
-    let (location, message) = obj(&format!("{tri}vn 0 0 1\nf 1//1 2//1 3//6148914691236517206\n"));
-    assert_eq!(location, "line 5");
-    assert!(message.contains("normal index 6148914691236517206 is out of range"), "{message}");
+    expect_at(
+        obj(&format!("{tri}vn 0 0 1\nf 1//1 2//1 3//6148914691236517206\n")),
+        "line 5",
+        "normal index 6148914691236517206 is out of range",
+    );
     // Points and lines are ignored, whatever their indices.
     io::obj::parse(format!("{tri}f 1 99\nl 5 6\nf 1 2 3\n").as_bytes(), Path::new("ok.obj")).unwrap();
     // A forward reference across objects fails in tobj but not in the scan: whole-file location.
-    let (location, message) = obj("o a\nv 0 0 0\nv 1 0 0\nf 1 2 3\no b\nv 0 1 0\n");
-    assert_eq!(location, "OBJ data");
-    assert!(message.contains("out of bounds"), "{message}");
+    expect_at(obj("o a\nv 0 0 0\nv 1 0 0\nf 1 2 3\no b\nv 0 1 0\n"), "OBJ data", "out of bounds");
 }
 
 #[test]
 fn obj_non_finite_vertices_name_their_line() {
-    let (location, message) = obj("v 0 0 0\nv 1 0 0\nv 0 nan 0\nv 0 1 0\nf 1 2 4\nf 4 3 1\n");
-    assert_eq!(location, "line 3");
-    assert_eq!(message, "vertex 2 has a NaN or infinite coordinate (0, NaN, 0)");
+    assert_eq!(
+        obj("v 0 0 0\nv 1 0 0\nv 0 nan 0\nv 0 1 0\nf 1 2 4\nf 4 3 1\n"),
+        at("line 3", "vertex 2 has a NaN or infinite coordinate (0, NaN, 0)")
+    );
     // A vertex no face uses is dropped by tobj, so it is no error.
     let mesh = io::obj::parse(b"v inf 0 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 2 3 4\n", Path::new("ok.obj"));
     assert_eq!(mesh.unwrap().positions.len(), 3);
