@@ -78,8 +78,9 @@ impl Mesh {
         Aabb::of(&self.positions)
     }
 
-    /// Checks what every algorithm relies on: finite coordinates within [`MAX_COORDINATE`], normals (if any) as many as
-    /// positions and finite, triangle indices in range. The error names the first offender.
+    /// Checks what every algorithm relies on: finite coordinates within [`MAX_COORDINATE`],
+    /// normals (if any) as many as positions and finite, triangle indices in range. The error
+    /// names the first offender.
     pub fn check(&self) -> Result<()> {
         check_positions(&self.positions, "vertex")?;
         if let Some(normals) = &self.normals {

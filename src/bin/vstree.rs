@@ -270,11 +270,11 @@ fn same_file(a: &Path, b: &Path) -> bool {
 /// simplification and the tree need them (reconstruction estimates its own).
 fn read_with_normals(path: &Path, threads: usize, quiet: bool) -> vstree::Result<vstree::Mesh> {
     let mut mesh = io::read(path)?;
-    let usable = |n: &Vec<glam::Vec3>| n.iter().all(|v| *v != glam::Vec3::ZERO);
-    if mesh.is_point_cloud() && !mesh.normals.as_ref().is_some_and(usable) {
+    if mesh.is_point_cloud() {
+        // Leaves complete normals as they are; estimates missing or zero ones.
         let params = vstree::normals::NormalParams { threads, ..Default::default() };
         let report = with_progress(quiet, |p| vstree::normals::ensure_normals(&mut mesh, &params, p))?;
-        if !quiet {
+        if !quiet && report.estimated > 0 {
             println!("normals: {} estimated from {} neighbours", report.estimated, report.neighbours);
         }
     }
