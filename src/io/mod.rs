@@ -8,11 +8,15 @@
 
 mod assemble;
 mod atomic;
+mod cleanup;
+mod input;
 pub mod obj;
 pub mod off;
 pub mod ply;
 mod text;
 pub mod xyz;
+
+pub use cleanup::remove_temporary_files_on_signals;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -45,7 +49,12 @@ impl Format {
     }
 
     /// Parses a whole file of this format held in memory; `path` is used only in messages.
+    /// A UTF-8 byte order mark at the start is skipped (editors on Windows write one).
     pub fn parse(self, bytes: &[u8], path: &Path) -> Result<Mesh> {
+        let bytes = without_bom(bytes);
+        if self != Format::Ply {
+            input::refuse_binary(bytes.get(..input::PREFIX_BYTES).unwrap_or(bytes), path)?;
+        }
         match self {
             Format::Ply => ply::parse(bytes, path),
             Format::Obj => obj::parse(bytes, path),
@@ -53,6 +62,25 @@ impl Format {
             Format::Xyz => xyz::parse(bytes, path),
         }
     }
+
+    /// Checks the first bytes of a file before the rest is read, so that a file of another
+    /// kind is refused at once: a PLY header (when `prefix` holds all of it), the OFF keyword,
+    /// no NUL byte in a text format. `more` says that the file goes on after `prefix`.
+    fn check_start(self, prefix: &[u8], more: bool, path: &Path) -> Result<()> {
+        let prefix = without_bom(prefix);
+        match self {
+            Format::Ply => match ply::check_header(prefix, path) {
+                Err(Error::Parse { location, .. }) if more && location == ply::UNFINISHED_HEADER => Ok(()),
+                result => result,
+            },
+            Format::Off => input::refuse_binary(prefix, path).and_then(|()| off::check_start(prefix, path)),
+            Format::Obj | Format::Xyz => input::refuse_binary(prefix, path),
+        }
+    }
+}
+
+fn without_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes)
 }
 
 /// How to write a file.
@@ -65,7 +93,7 @@ pub struct WriteOptions {
 /// Reads the mesh or point cloud at `path`, in the format its extension names.
 pub fn read(path: &Path) -> Result<Mesh> {
     let format = format_of(path)?;
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = input::read(path, format)?;
     format.parse(&bytes, path)
 }
 
@@ -78,14 +106,37 @@ pub fn write(path: &Path, mesh: &Mesh) -> Result<()> {
 /// (except in OFF, which has none). Point clouds get no faces. The mesh must pass
 /// [`Mesh::check`]. The file is replaced atomically: on error it is left as it was.
 pub fn write_with(path: &Path, mesh: &Mesh, options: &WriteOptions) -> Result<()> {
-    let format = format_of(path)?;
     mesh.check()?;
-    atomic::replace(path, |out| match format {
-        Format::Ply => ply::write(out, mesh, options.ascii),
-        Format::Obj => obj::write(out, mesh),
-        Format::Off => off::write(out, mesh),
-        Format::Xyz => xyz::write(out, mesh),
-    })
+    OutputFile::create(path)?.write(mesh, options)
+}
+
+/// An output reserved before the work that makes its content: the format is known, the
+/// target is one vstree may replace (a regular file it may write, or a new file; a symbolic
+/// link is followed) and its temporary file exists, so a bad output is reported before any
+/// work. Dropped without [`OutputFile::write`], it leaves the target as it was.
+pub struct OutputFile {
+    format: Format,
+    reserved: atomic::Reserved,
+}
+
+impl OutputFile {
+    /// Checks `path` as an output and creates its temporary file next to it.
+    pub fn create(path: &Path) -> Result<OutputFile> {
+        let format = format_of(path)?;
+        Ok(OutputFile { format, reserved: atomic::Reserved::new(path)? })
+    }
+
+    /// Writes `mesh` (which must pass [`Mesh::check`]) and puts it in place of the target.
+    pub fn write(self, mesh: &Mesh, options: &WriteOptions) -> Result<()> {
+        mesh.check()?;
+        let format = self.format;
+        self.reserved.fill(|out| match format {
+            Format::Ply => ply::write(out, mesh, options.ascii),
+            Format::Obj => obj::write(out, mesh),
+            Format::Off => off::write(out, mesh),
+            Format::Xyz => xyz::write(out, mesh),
+        })
+    }
 }
 
 fn format_of(path: &Path) -> Result<Format> {

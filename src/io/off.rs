@@ -65,6 +65,17 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     Ok(Mesh { positions, normals, triangles })
 }
 
+/// Checks the start of a file before it is read whole: the first content line, when `prefix`
+/// holds all of it, must begin with the OFF keyword.
+pub(crate) fn check_start(prefix: &[u8], path: &Path) -> Result<()> {
+    let complete = &prefix[..prefix.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1)];
+    if let Some((n, line)) = content_lines(complete).next() {
+        parse_keyword(line.split_whitespace().next().unwrap_or_default())
+            .map_err(|m| Error::parse(path, format!("line {n}"), m))?;
+    }
+    Ok(())
+}
+
 /// Lines with comments removed, skipping those left blank.
 fn content_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, Cow<'_, str>)> {
     text::lines(bytes).filter_map(|(n, line)| {

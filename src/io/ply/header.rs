@@ -48,6 +48,9 @@ pub(crate) struct Header {
     pub lines: usize,
 }
 
+/// The location of the error for a header without `end_header`.
+pub(crate) const UNFINISHED: &str = "header";
+
 /// Parses the header at the start of `bytes`.
 pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Header> {
     const BAD_MAGIC: &str = "not a PLY file: it must start with a `ply` line";
@@ -96,7 +99,7 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Header> {
             _ => return Err(fail(format!("unexpected header line {}", text::quoted(&line)))),
         }
     }
-    Err(Error::parse(path, "header", "file ends before `end_header`"))
+    Err(Error::parse(path, UNFINISHED, "file ends before `end_header`"))
 }
 
 /// Length of the first line of `bytes` including its `\n`.

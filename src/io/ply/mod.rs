@@ -23,6 +23,14 @@ use header::Encoding;
 use plan::Plan;
 use std::path::Path;
 
+/// The location of the error for a header that `end_header` does not finish.
+pub(crate) const UNFINISHED_HEADER: &str = header::UNFINISHED;
+
+/// Checks the header at the start of `bytes` without reading the body.
+pub(crate) fn check_header(bytes: &[u8], path: &Path) -> Result<()> {
+    header::parse(bytes, path).map(drop)
+}
+
 /// Parses a whole PLY file held in memory. `path` is used only in error messages.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     let header = header::parse(bytes, path)?;
