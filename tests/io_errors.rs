@@ -308,8 +308,11 @@ fn obj_errors_name_the_line() {
         "line 5",
         "normal index 6148914691236517206 is out of range",
     );
-    // Points and lines are ignored, whatever their indices.
-    io::obj::parse(format!("{tri}f 1 99\nl 5 6\nf 1 2 3\n").as_bytes(), Path::new("ok.obj")).unwrap();
+    // Points and lines are ignored, whatever their indices; a two-corner face is refused, as in
+    // PLY and OFF.
+    io::obj::parse(format!("{tri}p 99\nl 5 6\nf 1 2 3\n").as_bytes(), Path::new("ok.obj")).unwrap();
+    expect_at(obj(&format!("{tri}f 1 2 3\nf 1 2\n")), "line 5", "a face with 2 corners: a face needs at least 3");
+    expect_at(obj(&format!("{tri}f 1 # two\n")), "line 4", "a face with 1 corner: ");
     // A forward reference across objects fails in tobj but not in the scan: whole-file location.
     expect_at(obj("o a\nv 0 0 0\nv 1 0 0\nf 1 2 3\no b\nv 0 1 0\n"), "OBJ data", "out of bounds");
 }

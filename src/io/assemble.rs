@@ -2,6 +2,7 @@
 //! range, faces with at least three corners, finite positions and normals, and allocations
 //! bounded by the input's size. Messages are predicates meant to follow a subject such as `face 3: `.
 
+use crate::mesh::MAX_COORDINATE;
 use glam::Vec3;
 
 /// Converts a raw vertex index from a face to `u32`, checking it against `vertex_count`.
@@ -29,9 +30,17 @@ pub(crate) fn push_fan(polygon: &[u32], triangles: &mut Vec<[u32; 3]>) -> Result
     }
 }
 
-/// Returns `p` if all its coordinates are finite.
+/// Returns `p` if all its coordinates are finite and within [`MAX_COORDINATE`].
 pub(crate) fn finite_position(p: Vec3) -> Result<Vec3, String> {
-    finite(p, "coordinate")
+    let p = finite(p, "coordinate")?;
+    let largest = p.abs().max_element();
+    if largest > MAX_COORDINATE {
+        return Err(format!(
+            "has a coordinate of {largest:e}: at most {MAX_COORDINATE:e} in magnitude is supported (32-bit \
+             geometry); rescale the input"
+        ));
+    }
+    Ok(p)
 }
 
 /// Returns `n` if all its components are finite. Zero-length normals pass: they are valid

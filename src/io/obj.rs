@@ -1,7 +1,7 @@
 //! Wavefront OBJ through `tobj`, keeping position indexing (no per-corner vertex splitting).
 //!
-//! Polygons are fan-triangulated by tobj; points and lines (`p`, `l`, one- and two-corner
-//! `f`) are ignored. tobj numbers vertices in order of first use by a face and drops the ones
+//! Polygons are fan-triangulated by tobj; points and lines (`p`, `l`) are ignored, and an `f`
+//! with fewer than three corners is an error, as in the other formats. tobj numbers vertices in order of first use by a face and drops the ones
 //! no face uses; a file with no faces is read as a point cloud of all its `v` lines. Normals are
 //! kept only when they are per-vertex: as many normals as positions, indexed like them.
 //! Positions, and normals when kept, must be finite.
@@ -29,6 +29,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     text::reject_blank(bytes, path)?;
     // tobj rejects invalid UTF-8 anywhere, even in comments; numbers are ASCII anyway.
     let source = String::from_utf8_lossy(bytes);
+    if let Some((n, problem)) = scan::first_short_face(&source) {
+        return Err(Error::parse(path, format!("line {n}"), problem));
+    }
     // The update is needed when another crate in the build enables tobj's optional fields.
     #[allow(clippy::needless_update)]
     let options = tobj::LoadOptions {

@@ -46,6 +46,22 @@ pub(super) fn first_malformed(source: &str) -> Option<(usize, String)> {
     None
 }
 
+/// The first `f` line with fewer than three corners, as `(line, what is wrong)`: tobj drops
+/// such faces without a word, where PLY and OFF readers refuse them.
+pub(super) fn first_short_face(source: &str) -> Option<(usize, String)> {
+    text::lines(source.as_bytes()).find_map(|(n, line)| {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("f") {
+            return None;
+        }
+        let corners = words.take_while(|w| !w.starts_with('#')).count();
+        (corners < 3).then(|| {
+            let plural = if corners == 1 { "" } else { "s" };
+            (n, format!("a face with {corners} corner{plural}: a face needs at least 3 (a line is written with `l`)"))
+        })
+    })
+}
+
 /// The `v` (or `vn`) line of the first non-finite position (or normal) that a face uses, as
 /// `(line, what is wrong)`. Unused values are not reported: tobj drops them.
 pub(super) fn first_non_finite_use(source: &str, data: Data) -> Option<(usize, String)> {
