@@ -45,6 +45,16 @@ impl Error {
     }
 }
 
+/// `x` as messages show a parameter's value: plainly where that is short, else in exponent
+/// form (1e300 rather than three hundred digits).
+pub(crate) fn shown(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e6).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

@@ -270,10 +270,37 @@ fn rounding_noise(points: &[Vec3]) -> f64 {
     2.0 * f64::from(f32::EPSILON) * f64::from(largest)
 }
 
+/// Refuses a cloud with no volume to enclose: all at one place, on one line, or in one plane
+/// (thinner than [`FLAT`] of its extent). Such a cloud has no closed surface, and the
+/// reconstruction would fail later with a message about the wrong cause.
+pub(crate) fn refuse_flat(points: &[Vec3], threads: &Threads) -> Result<()> {
+    let (_, thickness) = plane_and_thickness(points, threads)?;
+    if thickness <= FLAT {
+        return Err(Error::input(format!(
+            "all {} points lie in one plane (thickness {} of the cloud's extent): they enclose \
+             no volume, so there is no closed surface to reconstruct",
+            points.len(),
+            crate::error::shown(thickness)
+        )));
+    }
+    Ok(())
+}
+
+/// The thickness (smallest over largest spread, a ratio) below which a cloud counts as flat:
+/// f32 positions of a plane spanning the cloud vary by about 1e-7 of its extent, and any
+/// real object is much thicker than 1e-5 of its size.
+const FLAT: f64 = 1e-5;
+
 /// The normal of the plane through the whole cloud (the fallback for points none of whose
 /// neighbours has a normal), or an error when all points are at one place or on one line.
 /// Checked before any neighbour search, so such input fails fast.
 fn plane_through(points: &[Vec3], threads: &Threads) -> Result<Vec3> {
+    plane_and_thickness(points, threads).map(|(normal, _)| normal)
+}
+
+/// [`plane_through`], with the cloud's thickness: the spread along the plane's normal over the
+/// largest spread (standard deviations), 0 for a plane.
+fn plane_and_thickness(points: &[Vec3], threads: &Threads) -> Result<(Vec3, f64)> {
     let n = points.len();
     let origin = points[0].as_dvec3();
     let partial: Vec<(DVec3, Sym3)> = threads.run(|| {
@@ -299,12 +326,12 @@ fn plane_through(points: &[Vec3], threads: &Threads) -> Result<Vec3> {
     let noise = rounding_noise(points);
     let floor = noise * noise * n as f64;
     if values[0] <= floor {
-        return Err(Error::input(format!("all {n} points are at the same place: no plane to estimate normals from")));
+        return Err(Error::input(format!("all {n} points are at the same place: no surface passes through them")));
     }
     if values[1] <= floor.max(1e-12 * values[0]) {
-        return Err(Error::input(format!("all {n} points lie on one line: no plane to estimate normals from")));
+        return Err(Error::input(format!("all {n} points lie on one line: no surface passes through them")));
     }
-    Ok(vectors[2].as_vec3())
+    Ok((vectors[2].as_vec3(), (values[2].max(0.0) / values[0]).sqrt()))
 }
 
 /// The k-NN graph of a cloud, in the k-d tree's point order (neighbouring points are close in

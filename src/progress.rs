@@ -56,6 +56,10 @@ pub struct Threads {
 }
 
 impl Threads {
+    /// A pool of `count` threads (0 = rayon's global pool, one per core). More threads than
+    /// the machine runs at once only take turns (a thousand make a small job hundreds of times
+    /// slower), so the
+    /// count is capped at [`Threads::count_for`]; results are the same for any count.
     pub fn new(count: usize) -> Result<Threads> {
         if count > 1024 {
             return Err(Error::param("threads", format!("{count} is absurd (0 = all cores, at most 1024)")));
@@ -64,12 +68,23 @@ impl Threads {
             0 => None,
             n => Some(
                 rayon::ThreadPoolBuilder::new()
-                    .num_threads(n)
+                    .num_threads(Threads::count_for(n))
                     .build()
                     .map_err(|e| Error::input(format!("cannot start {n} threads: {e}")))?,
             ),
         };
         Ok(Threads { pool })
+    }
+
+    /// The threads a request for `count` gets: `count` (0 = all cores), at most one per core
+    /// the machine runs at once.
+    pub fn count_for(count: usize) -> usize {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        if count == 0 {
+            cores
+        } else {
+            count.min(cores)
+        }
     }
 
     /// Runs `work` (which may use rayon's parallel iterators) on these threads.

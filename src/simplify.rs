@@ -3,7 +3,7 @@
 //! its cell; triangles are re-indexed to representatives, and those that collapse or repeat
 //! are dropped. The input's winding is kept, and non-manifold input is fine.
 
-use crate::error::{Error, Result};
+use crate::error::{shown, Error, Result};
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
 use crate::quadric::CellStats;
@@ -148,6 +148,19 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
         let labels = vertex_labels(mesh, &samples, &clusters, params.sampling, &tree);
         collapse(mesh, &labels, &clusters.representatives, &threads)?
     };
+    if !mesh.triangles.is_empty() && out.triangles.is_empty() {
+        return Err(Error::param(
+            "error",
+            format!(
+                "{}: every triangle collapsed ({} cluster{} for the whole model): the model is within \
+                 this bound of too few planes; use a smaller bound (a flat model, within any bound of one \
+                 plane, needs the density metric)",
+                shown(params.tree.error),
+                stats.leaves,
+                if stats.leaves == 1 { "" } else { "s" }
+            ),
+        ));
+    }
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
         tree: stats,

@@ -204,6 +204,8 @@ impl TreeArgs {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Ctrl-C or a kill while an output is pending must not leave its hidden temporary file.
+    io::remove_temporary_files_on_signals();
     match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -220,6 +222,7 @@ fn message(e: &vstree::Error) -> String {
     };
     let flag = match *name {
         "error" => "--error",
+        "tree_kind" => "--tree",
         "d_a" => "--da",
         "d_d" => "--dd",
         "max_depth" => "--max-depth",
@@ -234,19 +237,17 @@ fn message(e: &vstree::Error) -> String {
     format!("{flag}: {message}")
 }
 
-/// Refuses, before any work is done, an output vstree cannot write or that is the input itself
-/// (the input is never overwritten, even by a successful run).
-fn check_output(input: &Path, output: &Path) -> vstree::Result<()> {
-    if io::Format::from_path(output).is_none() {
-        return Err(vstree::Error::UnsupportedFormat { path: output.to_path_buf() });
-    }
+/// Reserves the output before any work is done: refused when vstree cannot write it (format,
+/// folder, permissions, not a regular file) or when it is the input itself (the input is never
+/// overwritten, even by a successful run).
+fn reserve_output(input: &Path, output: &Path) -> vstree::Result<io::OutputFile> {
     if same_file(input, output) {
         return Err(vstree::Error::InvalidInput(format!(
             "the output {} is the input file: write the result to another file",
             output.display()
         )));
     }
-    Ok(())
+    io::OutputFile::create(output)
 }
 
 /// Whether both paths name one existing file (through links too).
@@ -286,11 +287,12 @@ fn run(command: Command) -> vstree::Result<()> {
         Command::Simplify { input, output, tree, sampling, ascii } => {
             let tree_params = tree.params(SIMPLIFY_ERROR);
             tree_params.check()?; // before reading what may be a large file
-            check_output(&input, &output)?;
+            let target = reserve_output(&input, &output)?;
+            say_threads(tree.threads, tree.quiet);
             let (mesh, read_s) = timed(|| read_with_normals(&input, tree.threads, tree.quiet))?;
             let params = SimplifyParams { tree: tree_params, sampling: sampling.into(), threads: tree.threads };
             let (out, stats) = with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
-            let (_, write_s) = timed(|| io::write_with(&output, &out, &io::WriteOptions { ascii }))?;
+            let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
                 print_simplify(&input, &output, &stats, read_s, write_s);
             }
@@ -308,11 +310,12 @@ fn run(command: Command) -> vstree::Result<()> {
                 ..ReconstructParams::default()
             };
             params.check()?;
-            check_output(&input, &output)?;
+            let target = reserve_output(&input, &output)?;
+            say_threads(tree.threads, tree.quiet);
             let (mut cloud, read_s) = timed(|| io::read(&input))?;
             cloud.triangles.clear();
             let (out, stats) = with_progress(tree.quiet, |progress| reconstruct(&cloud, &params, progress))?;
-            let (_, write_s) = timed(|| io::write_with(&output, &out, &io::WriteOptions { ascii }))?;
+            let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
                 print_reconstruct(&input, &output, cloud.positions.len(), &stats, read_s, write_s);
             }
@@ -322,6 +325,7 @@ fn run(command: Command) -> vstree::Result<()> {
         Command::Stats { input, tree, sampling, compare } => {
             let tree_params = tree.params(SIMPLIFY_ERROR);
             tree_params.check()?;
+            say_threads(tree.threads, tree.quiet);
             let mesh = read_with_normals(&input, tree.threads, tree.quiet)?;
             let samples = if mesh.is_point_cloud() {
                 SampleSet::from_cloud(&mesh)?
@@ -350,6 +354,15 @@ fn run(command: Command) -> vstree::Result<()> {
             }
             Ok(())
         }
+    }
+}
+
+/// Says when `--threads` asks for more threads than the machine has cores (they would only
+/// take turns), since the library then uses one per core.
+fn say_threads(requested: usize, quiet: bool) {
+    let used = Threads::count_for(requested);
+    if !quiet && requested > used {
+        eprintln!("vstree: --threads {requested}: this machine runs {used} at once; using {used}");
     }
 }
 

@@ -27,14 +27,14 @@ mod winding;
 pub use refine::LevelStats;
 
 use crate::distance::{PointBvh, TriangleBvh};
-use crate::error::{Error, Result};
+use crate::error::{shown, Error, Result};
 use crate::mesh::Mesh;
 use crate::normals::{self, NormalParams, NormalsReport};
 use crate::polygonize::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
 use crate::progress::{Progress, Threads};
 use crate::samples::SampleSet;
 use crate::topology;
-use crate::tree::{self, NodeKind, TreeParams, TreeSample, TreeStats, VsTree};
+use crate::tree::{self, NodeKind, TreeKind, TreeParams, TreeSample, TreeStats, VsTree};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -125,6 +125,13 @@ impl ReconstructParams {
     /// Rejects values outside their documented ranges, naming the parameter.
     pub fn check(&self) -> Result<()> {
         self.tree.check()?;
+        if self.tree.kind != TreeKind::VsTree {
+            return Err(Error::param(
+                "tree_kind",
+                "octree: reconstruction needs the VS-Tree, whose T-nodes make the base mesh (the octree is \
+                 for simplification)",
+            ));
+        }
         if !(self.target_distance.is_finite() && self.target_distance >= 0.0) {
             return Err(Error::param("target_distance", format!("{}: must be >= 0", self.target_distance)));
         }
@@ -197,6 +204,47 @@ pub struct ReconstructStats {
     pub seconds_trim: f64,
 }
 
+/// The error for a tree without T-nodes, naming the parameter that stopped it short of the
+/// surface: every leaf is then an octree cell, left unsplit because it was at the deepest
+/// level, at the smallest cell size, or within the error bound.
+fn why_no_t_node(tree: &VsTree, params: &TreeParams) -> Error {
+    let leaves = || tree.nodes.iter().filter(|n| n.is_leaf());
+    let default = TreeParams::default();
+    if leaves().any(|n| u32::from(n.depth) >= params.max_depth) {
+        return Error::param(
+            "max_depth",
+            format!(
+                "{}: the tree reached this depth before any cell saw the surface as a height field, so \
+                 there is nothing to make the base mesh from; allow a deeper tree (default {})",
+                params.max_depth, default.max_depth
+            ),
+        );
+    }
+    let smallest = 0.5 * params.min_cell_size * f64::from(tree.diagonal);
+    if leaves().any(|n| f64::from(n.half) <= smallest) {
+        return Error::param(
+            "min_cell_size",
+            format!(
+                "{}: cells this small are not split, and none of the larger ones saw the surface as a \
+                 height field; use a smaller value (default {:e})",
+                shown(params.min_cell_size),
+                default.min_cell_size
+            ),
+        );
+    }
+    Error::param(
+        "error",
+        format!(
+            "{}: the cloud fits this bound in {} octree cell{} too coarse to see the surface as a height \
+             field, so there is nothing to make the base mesh from; use a smaller bound (default {:e})",
+            shown(params.error),
+            leaves().count(),
+            if leaves().count() == 1 { "" } else { "s" },
+            ReconstructParams::default().tree.error
+        ),
+    )
+}
+
 /// Reconstructs a triangle mesh from a point cloud with (outward) normals.
 pub fn reconstruct(
     cloud: &Mesh,
@@ -208,6 +256,8 @@ pub fn reconstruct(
         return Err(Error::input(format!("{} points: at least {MIN_POINTS} are needed", cloud.positions.len())));
     }
     let threads = Threads::new(params.threads)?;
+    crate::mesh::check_positions(&cloud.positions, "point")?;
+    normals::refuse_flat(&cloud.positions, &threads)?;
     let mut stats = ReconstructStats::default();
     let start = Instant::now();
     let mut oriented = Mesh::from_points(cloud.positions.clone(), cloud.normals.clone());
@@ -221,9 +271,7 @@ pub fn reconstruct(
     let tree = tree::build(&samples, &params.tree, &threads, &mut progress.stage(0.15, 0.35))?;
     stats.tree = tree.stats();
     if stats.tree.t_nodes == 0 {
-        return Err(Error::input(
-            "no part of the cloud is a height field: no T-node, no surface (are the normals consistent?)",
-        ));
+        return Err(why_no_t_node(&tree, &params.tree));
     }
     let t1 = Instant::now();
 

@@ -11,7 +11,7 @@ mod locate;
 mod partition;
 mod validate;
 
-use crate::error::{Error, Result};
+use crate::error::{shown, Error, Result};
 use crate::quadric::CellStats;
 use glam::{DVec3, Vec2, Vec3};
 
@@ -87,7 +87,11 @@ impl TreeParams {
                 return Err(Error::param("error", format!("{} samples per cell: must be at least 1", self.error)))
             }
             _ if !positive => {
-                return Err(Error::param("error", format!("{}: must be a finite number > 0", self.error)))
+                return Err(Error::param("error", format!("{}: must be a finite number > 0", shown(self.error))))
+            }
+            // |n - m|² of unit vectors n and m is at most 4: a larger bound never splits.
+            Metric::L21 if self.error > 4.0 => {
+                return Err(Error::param("error", format!("{}: the L2,1 bound must be in (0, 4]", shown(self.error))))
             }
             _ => {}
         }
