@@ -89,8 +89,18 @@ def _check(status):
         raise cls(status, message)
 
 
+def _c_string(value, what):
+    """The bytes of a path or name (str, bytes or os.PathLike) for a NUL-terminated C string.
+    C ends the string at the first NUL, so a path with one in it would name another file
+    ("victim.ply\\0-simplified.ply" would overwrite victim.ply): refuse it, as open() does."""
+    encoded = os.fsencode(value)
+    if b"\0" in encoded:
+        raise ValueError("%s contains an embedded null byte: %r" % (what, os.fspath(value)))
+    return encoded
+
+
 def _path(path):
-    return os.fsencode(path)
+    return _c_string(path, "path")
 
 
 class Mesh:
@@ -137,10 +147,11 @@ class Mesh:
 
     @classmethod
     def from_bytes(cls, data, name):
-        """Parses a whole file held in memory; ``name`` ("scan.ply" or "ply") gives the format."""
+        """Parses a whole file held in memory; ``name`` ("scan.ply" or "ply"; str, bytes or
+        os.PathLike) gives the format."""
         data = bytes(data)
         handle = ctypes.c_void_p()
-        _check(lib.vstree_mesh_load_memory(data, len(data), name.encode(), ctypes.byref(handle)))
+        _check(lib.vstree_mesh_load_memory(data, len(data), _c_string(name, "name"), ctypes.byref(handle)))
         return cls._wrap(handle.value)
 
     def save(self, path, ascii=False):
