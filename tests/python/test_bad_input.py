@@ -65,6 +65,11 @@ class Context:
         mesh.close()
         return mesh
 
+    def closed_tree(self):
+        with vstree.Tree(self.mesh()) as tree:
+            pass
+        return tree
+
 
 def case(id, call, exc, status, message, exact=True):
     """One row: ``call(ctx)`` must raise exactly ``exc`` with ``status`` (None: not a
@@ -132,7 +137,39 @@ NUL_CASES = [
     ),
 ]
 
-CASES = NUL_CASES
+
+# ---- closed objects: a clear error, not the C library's NULL pointer -----------------------
+
+MESH_CLOSED = "the mesh was closed"
+TREE_CLOSED = "the tree was closed"
+
+
+def closed_result_mesh(c):
+    with vstree.simplify(c.mesh()).mesh as mesh:
+        pass
+    return mesh.positions
+
+
+CLOSED_CASES = [
+    case("closed-mesh-save", lambda c: c.closed_mesh().save(c.tmp / "out.ply"), ValueError, None, MESH_CLOSED),
+    case("closed-mesh-vertex-count", lambda c: c.closed_mesh().vertex_count, ValueError, None, MESH_CLOSED),
+    case("closed-mesh-triangle-count", lambda c: c.closed_mesh().triangle_count, ValueError, None, MESH_CLOSED),
+    case("closed-mesh-has-normals", lambda c: c.closed_mesh().has_normals, ValueError, None, MESH_CLOSED),
+    case("closed-mesh-positions", lambda c: c.closed_mesh().positions, ValueError, None, MESH_CLOSED),
+    case("closed-mesh-normals", lambda c: c.closed_mesh().normals, ValueError, None, MESH_CLOSED),
+    case("closed-mesh-triangles", lambda c: c.closed_mesh().triangles, ValueError, None, MESH_CLOSED),
+    case("closed-result-mesh-positions", closed_result_mesh, ValueError, None, MESH_CLOSED),
+    case("simplify-closed-mesh", lambda c: vstree.simplify(c.closed_mesh()), ValueError, None, MESH_CLOSED),
+    case("tree-of-closed-mesh", lambda c: vstree.Tree(c.closed_mesh()), ValueError, None, MESH_CLOSED),
+    case("reconstruct-closed-mesh", lambda c: vstree.reconstruct(c.closed_mesh()), ValueError, None, MESH_CLOSED),
+    case("normals-of-closed-mesh", lambda c: vstree.estimate_normals(c.closed_mesh()), ValueError, None, MESH_CLOSED),
+    case("closed-tree-nodes", lambda c: c.closed_tree().nodes, ValueError, None, TREE_CLOSED),
+    case("closed-tree-t-nodes", lambda c: c.closed_tree().t_nodes, ValueError, None, TREE_CLOSED),
+    case("closed-tree-levels", lambda c: c.closed_tree().levels, ValueError, None, TREE_CLOSED),
+    case("closed-tree-vertex-labels", lambda c: c.closed_tree().vertex_labels("t_node"), ValueError, None, TREE_CLOSED),
+]
+
+CASES = NUL_CASES + CLOSED_CASES
 
 
 @pytest.mark.parametrize("call, exc, status, message, exact", CASES)
@@ -178,3 +215,14 @@ def test_a_path_with_nul_leaves_the_file_before_it_unchanged(tmp_path):
     # The path up to the NUL is not read either.
     with pytest.raises(ValueError, match="embedded null byte"):
         vstree.load(str(victim) + "\0")
+
+
+def test_closing_twice_is_harmless_and_a_closed_object_says_so():
+    mesh = vstree.Mesh(P, T)
+    tree = vstree.Tree(mesh)
+    stats = tree.stats
+    for thing in (mesh, tree):
+        thing.close()
+        thing.close()
+    assert repr(mesh) == "<vstree.Mesh closed>"
+    assert tree.stats == stats and stats["vertices"] == len(P)  # a copy, kept after close()

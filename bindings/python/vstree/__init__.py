@@ -156,7 +156,7 @@ class Mesh:
 
     def save(self, path, ascii=False):
         """Writes the mesh (format from the extension; atomic: on error the file is unchanged)."""
-        _check(lib.vstree_mesh_save(self._handle, _path(path), 1 if ascii else 0))
+        _check(lib.vstree_mesh_save(self._live(), _path(path), 1 if ascii else 0))
 
     def close(self):
         """Frees the mesh now (it is freed when garbage-collected otherwise)."""
@@ -177,9 +177,12 @@ class Mesh:
         self.close()
 
     def _live(self):
-        if not self._handle:
+        """The handle, for every call that uses it; a closed mesh has none (C would report a
+        NULL pointer instead of saying why)."""
+        handle = getattr(self, "_handle", None)
+        if not handle:
             raise ValueError("the mesh was closed")
-        return self._handle
+        return handle
 
     @property
     def vertex_count(self):
@@ -217,7 +220,7 @@ class Mesh:
         return out
 
     def __repr__(self):
-        if not self._handle:
+        if not getattr(self, "_handle", None):
             return "<vstree.Mesh closed>"
         return "<vstree.Mesh %d vertices, %d triangles%s>" % (
             self.vertex_count,
@@ -383,11 +386,16 @@ class Tree:
     def __exit__(self, *exc):
         self.close()
 
-    def _copy(self, struct, count, copy):
-        if not self._handle:
+    def _live(self):
+        handle = getattr(self, "_handle", None)
+        if not handle:
             raise ValueError("the tree was closed")
-        out = np.zeros(count(self._handle), dtype=np.dtype(struct))
-        _check(copy(self._handle, out.ctypes.data_as(ctypes.POINTER(struct)), out.size))
+        return handle
+
+    def _copy(self, struct, count, copy):
+        handle = self._live()
+        out = np.zeros(count(handle), dtype=np.dtype(struct))
+        _check(copy(handle, out.ctypes.data_as(ctypes.POINTER(struct)), out.size))
         return out
 
     @property
@@ -413,10 +421,9 @@ class Tree:
         kinds = {"cluster": 0, "t_node": 1}
         if kind not in kinds:
             raise ValueError("kind must be 'cluster' or 't_node', not %r" % (kind,))
-        if not self._handle:
-            raise ValueError("the tree was closed")
-        out = np.empty(lib.vstree_tree_vertex_count(self._handle), np.uint32)
-        _check(lib.vstree_tree_copy_vertex_labels(self._handle, kinds[kind], out.ctypes.data_as(_ffi._U32P), out.size))
+        handle = self._live()
+        out = np.empty(lib.vstree_tree_vertex_count(handle), np.uint32)
+        _check(lib.vstree_tree_copy_vertex_labels(handle, kinds[kind], out.ctypes.data_as(_ffi._U32P), out.size))
         return out
 
 
