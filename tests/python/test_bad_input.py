@@ -169,7 +169,187 @@ CLOSED_CASES = [
     case("closed-tree-vertex-labels", lambda c: c.closed_tree().vertex_labels("t_node"), ValueError, None, TREE_CLOSED),
 ]
 
-CASES = NUL_CASES + CLOSED_CASES
+
+# ---- parameters: the library's ranges, and the binding's types ------------------------------
+
+NAN, INF = float("nan"), float("inf")
+BAD = S.INVALID_PARAMETER
+
+
+def simplify_with(**params):
+    return lambda c: vstree.simplify(c.mesh(), **params)
+
+
+def tree_with(**params):
+    return lambda c: vstree.Tree(c.mesh(), **params)
+
+
+def reconstruct_with(**params):
+    return lambda c: vstree.reconstruct(CLOUD, CLOUD, **params)
+
+
+def normals_with(**params):
+    return lambda c: vstree.estimate_normals(CLOUD, **params)
+
+
+ENUM_TREE = "must be one of 0 (VSTREE_TREE_KIND_VS_TREE), 1 (VSTREE_TREE_KIND_OCTREE)"
+ENUM_METRIC = "must be one of 0 (VSTREE_METRIC_L2), 1 (VSTREE_METRIC_L21), 2 (VSTREE_METRIC_DENSITY)"
+ENUM_SAMPLING = "must be one of 0 (VSTREE_SAMPLING_VERTICES), 1 (VSTREE_SAMPLING_FACE_CENTERS)"
+ENUM_ORIENT = (
+    "must be one of 0 (VSTREE_ORIENTATION_UNORIENTED), 1 (VSTREE_ORIENTATION_PROPAGATE), "
+    "2 (VSTREE_ORIENTATION_PROPAGATE_MAJORITY), 3 (VSTREE_ORIENTATION_PROPAGATE_OUTWARD)"
+)
+ORIENT_NAMES = "'propagate', 'propagate_majority', 'propagate_outward', 'unoriented'"
+
+PARAMETER_CASES = [
+    # simplify: the library checks the ranges.
+    case("simplify-error-negative", simplify_with(error=-1.0), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `error`: -1: must be a finite number > 0"),
+    case("simplify-error-zero", simplify_with(error=0.0), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `error`: 0: must be a finite number > 0"),
+    case("simplify-error-nan", simplify_with(error=NAN), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `error`: NaN: must be a finite number > 0"),
+    case("simplify-error-inf", simplify_with(error=INF), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `error`: inf: must be a finite number > 0"),
+    case("simplify-d_a-too-big", simplify_with(d_a=2.0), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `d_a`: 2: must be in [0, 1]"),
+    case("simplify-d_a-nan", simplify_with(d_a=NAN), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `d_a`: NaN: must be in [0, 1]"),
+    case("simplify-d_d-negative", simplify_with(d_d=-0.5), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `d_d`: -0.5: must be in [0, 1]"),
+    case("simplify-d_d-inf", simplify_with(d_d=INF), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `d_d`: inf: must be in [0, 1]"),
+    case("simplify-max_depth-zero", simplify_with(max_depth=0), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `max_depth`: 0: must be in 1..=30"),
+    case("simplify-max_depth-too-big", simplify_with(max_depth=99), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `max_depth`: 99: must be in 1..=30"),
+    case("simplify-threads-too-many", simplify_with(threads=5000), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `threads`: 5000: must be 0 (all cores) to 1024"),
+    case("simplify-min_cell_size-one", simplify_with(min_cell_size=1.0), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `min_cell_size`: 1: must be in [0, 1)"),
+    case("simplify-min_cell_size-negative", simplify_with(min_cell_size=-1.0), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `min_cell_size`: -1: must be in [0, 1)"),
+    case("simplify-tree_kind-number", simplify_with(tree_kind=7), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `tree_kind`: 7: " + ENUM_TREE),
+    case("simplify-metric-number", simplify_with(metric=3), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `metric`: 3: " + ENUM_METRIC),
+    case("simplify-sampling-number", simplify_with(sampling=2), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `sampling`: 2: " + ENUM_SAMPLING),
+    # simplify: what the binding refuses before C (names, types, C field widths).
+    case("simplify-tree_kind-quadtree", simplify_with(tree_kind="quadtree"), ValueError, None,
+         "vstree.simplify: parameter `tree_kind`: 'quadtree' is not one of 'octree', 'vstree'"),
+    case("simplify-metric-unknown-name", simplify_with(metric="l1"), ValueError, None,
+         "vstree.simplify: parameter `metric`: 'l1' is not one of 'density', 'l2', 'l21'"),
+    case("simplify-sampling-unknown-name", simplify_with(sampling="edges"), ValueError, None,
+         "vstree.simplify: parameter `sampling`: 'edges' is not one of 'face_centers', 'faces', 'vertices'"),
+    case("simplify-tree_kind-float", simplify_with(tree_kind=1.5), TypeError, None,
+         "vstree.simplify: parameter `tree_kind`: must be one of 'octree', 'vstree' or an integer, not 1.5 (float)"),
+    case("simplify-tree_kind-beyond-int32", simplify_with(tree_kind=2**40), vstree.VstreeError, BAD,
+         "vstree.simplify: parameter `tree_kind`: 1099511627776 is out of range for the C field (int32)"),
+    case("simplify-max_depth-negative", simplify_with(max_depth=-1), vstree.VstreeError, BAD,
+         "vstree.simplify: parameter `max_depth`: -1 is out of range for the C field (uint32)"),
+    case("simplify-max_depth-2^32", simplify_with(max_depth=2**32), vstree.VstreeError, BAD,
+         "vstree.simplify: parameter `max_depth`: 4294967296 is out of range for the C field (uint32)"),
+    case("simplify-max_depth-float-not-truncated", simplify_with(max_depth=1.5), TypeError, None,
+         "vstree.simplify: parameter `max_depth`: must be an integer, not 1.5 (float)"),
+    case("simplify-max_depth-nan", simplify_with(max_depth=NAN), TypeError, None,
+         "vstree.simplify: parameter `max_depth`: must be an integer, not nan (float)"),
+    case("simplify-threads-negative-numpy", simplify_with(threads=np.int64(-1)), vstree.VstreeError, BAD,
+         "vstree.simplify: parameter `threads`: -1 is out of range for the C field (uint32)"),
+    case("simplify-error-string", simplify_with(error="big"), TypeError, None,
+         "vstree.simplify: parameter `error`: must be a real number, not 'big' (str)"),
+    case("simplify-error-none", simplify_with(error=None), TypeError, None,
+         "vstree.simplify: parameter `error`: must be a real number, not None (NoneType)"),
+    case("simplify-unknown-parameter", simplify_with(eror=1e-3), TypeError, None,
+         "vstree.simplify: unknown parameter 'eror' (the parameters are error, tree_kind, metric, "
+         "sampling, d_a, d_d, max_depth, threads, min_cell_size)"),
+    # Tree: the same parameters, its own function name.
+    case("tree-tree_kind-quadtree", tree_with(tree_kind="quadtree"), ValueError, None,
+         "vstree.Tree: parameter `tree_kind`: 'quadtree' is not one of 'octree', 'vstree'"),
+    case("tree-error-nan", tree_with(error=NAN), vstree.VstreeError, BAD,
+         "vstree_tree_build: parameter `error`: NaN: must be a finite number > 0"),
+    case("tree-max_depth-too-big", tree_with(max_depth=31), vstree.VstreeError, BAD,
+         "vstree_tree_build: parameter `max_depth`: 31: must be in 1..=30"),
+    case("tree-metric-negative", tree_with(metric=-1), vstree.VstreeError, BAD,
+         "vstree_tree_build: parameter `metric`: -1: " + ENUM_METRIC),
+    case("tree-threads-float", tree_with(threads=2.0), TypeError, None,
+         "vstree.Tree: parameter `threads`: must be an integer, not 2.0 (float)"),
+    # reconstruct
+    case("reconstruct-error-zero", reconstruct_with(error=0.0), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `error`: 0: must be a finite number > 0"),
+    case("reconstruct-d_a-too-big", reconstruct_with(d_a=1.5), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `d_a`: 1.5: must be in [0, 1]"),
+    case("reconstruct-max_depth-zero", reconstruct_with(max_depth=0), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `max_depth`: 0: must be in 1..=30"),
+    case("reconstruct-max_levels-too-big", reconstruct_with(max_levels=13), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `max_levels`: 13: must be in 0..=12"),
+    case("reconstruct-max_levels-negative", reconstruct_with(max_levels=-1), vstree.VstreeError, BAD,
+         "vstree.reconstruct: parameter `max_levels`: -1 is out of range for the C field (uint32)"),
+    case("reconstruct-max_levels-float-not-truncated", reconstruct_with(max_levels=2.7), TypeError, None,
+         "vstree.reconstruct: parameter `max_levels`: must be an integer, not 2.7 (float)"),
+    case("reconstruct-min_cell_size-nan", reconstruct_with(min_cell_size=NAN), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `min_cell_size`: NaN: must be in [0, 1)"),
+    case("reconstruct-target_distance-negative", reconstruct_with(target_distance=-1.0), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `target_distance`: -1: must be >= 0"),
+    case("reconstruct-target_distance-inf", reconstruct_with(target_distance=INF), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `target_distance`: inf: must be >= 0"),
+    case("reconstruct-min_displaced-too-big", reconstruct_with(min_displaced=2.0), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `min_displaced`: 2: must be in [0, 1]"),
+    case("reconstruct-min_displaced-nan", reconstruct_with(min_displaced=NAN), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `min_displaced`: NaN: must be in [0, 1]"),
+    case("reconstruct-max_triangles-zero", reconstruct_with(max_triangles=0), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `max_triangles`: 0: must be in 1..=2^32-1"),
+    case("reconstruct-max_triangles-2^32", reconstruct_with(max_triangles=2**32), vstree.VstreeError, BAD,
+         "vstree.reconstruct: parameter `max_triangles`: 4294967296 is out of range for the C field (uint32)"),
+    case("reconstruct-max_grid_depth-too-small", reconstruct_with(max_grid_depth=3), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `max_grid_depth`: 3: must be in 4..=20"),
+    case("reconstruct-max_grid_depth-too-big", reconstruct_with(max_grid_depth=21), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `max_grid_depth`: 21: must be in 4..=20"),
+    case("reconstruct-trim-negative", reconstruct_with(trim=-1.0), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `trim`: -1: must be >= 0"),
+    case("reconstruct-trim-inf", reconstruct_with(trim=INF), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `trim`: inf: must be >= 0"),
+    case("reconstruct-trim-string", reconstruct_with(trim="x"), TypeError, None,
+         "vstree.reconstruct: parameter `trim`: must be a real number, not 'x' (str)"),
+    case("reconstruct-neighbours-too-few", reconstruct_with(neighbours=2), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `neighbours`: 2 is not in 3..=256"),
+    case("reconstruct-reorient_given-two", reconstruct_with(reorient_given=2), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `reorient_given`: 2: must be 0 or 1"),
+    case("reconstruct-threads-too-many", reconstruct_with(threads=1025), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `threads`: 1025: must be 0 (all cores) to 1024"),
+    case("reconstruct-orient-number", reconstruct_with(orient=9), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `orient`: 9: " + ENUM_ORIENT),
+    case("reconstruct-orient-inward", reconstruct_with(orient="inward"), ValueError, None,
+         "vstree.reconstruct: parameter `orient`: 'inward' is not one of " + ORIENT_NAMES),
+    case("reconstruct-orient-none", reconstruct_with(orient=None), TypeError, None,
+         "vstree.reconstruct: parameter `orient`: must be one of %s or an integer, not None (NoneType)" % ORIENT_NAMES),
+    case("reconstruct-simplify-only-parameter", reconstruct_with(metric="l2"), TypeError, None,
+         "vstree.reconstruct: unknown parameter 'metric' (the parameters are error, orient, d_a, d_d, "
+         "max_depth, max_levels, min_cell_size, target_distance, min_displaced, max_triangles, "
+         "max_grid_depth, trim, neighbours, reorient_given, threads)"),
+    # estimate_normals
+    case("normals-neighbours-too-many", normals_with(neighbours=300), vstree.VstreeError, BAD,
+         "vstree_estimate_normals: parameter `neighbours`: 300 is not in 3..=256"),
+    case("normals-neighbours-zero", normals_with(neighbours=0), vstree.VstreeError, BAD,
+         "vstree_estimate_normals: parameter `neighbours`: 0 is not in 3..=256"),
+    case("normals-neighbours-negative", normals_with(neighbours=-1), vstree.VstreeError, BAD,
+         "vstree.estimate_normals: parameter `neighbours`: -1 is out of range for the C field (uint32)"),
+    case("normals-neighbours-float-not-truncated", normals_with(neighbours=16.5), TypeError, None,
+         "vstree.estimate_normals: parameter `neighbours`: must be an integer, not 16.5 (float)"),
+    case("normals-orient-negative", normals_with(orient=-1), vstree.VstreeError, BAD,
+         "vstree_estimate_normals: parameter `orient`: -1: " + ENUM_ORIENT),
+    case("normals-orient-outward", normals_with(orient="outward"), ValueError, None,
+         "vstree.estimate_normals: parameter `orient`: 'outward' is not one of " + ORIENT_NAMES),
+    case("normals-reorient_given-two", normals_with(reorient_given=2), vstree.VstreeError, BAD,
+         "vstree_estimate_normals: parameter `reorient_given`: 2: must be 0 or 1"),
+    case("normals-threads-too-many", normals_with(threads=2000), vstree.VstreeError, BAD,
+         "vstree_estimate_normals: parameter `threads`: 2000: must be 0 (all cores) to 1024"),
+    case("normals-reconstruct-only-parameter", normals_with(error=1e-3), TypeError, None,
+         "vstree.estimate_normals: unknown parameter 'error' (the parameters are orient, neighbours, "
+         "reorient_given, threads)"),
+]
+
+CASES = NUL_CASES + CLOSED_CASES + PARAMETER_CASES
 
 
 @pytest.mark.parametrize("call, exc, status, message, exact", CASES)

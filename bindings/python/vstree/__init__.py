@@ -18,6 +18,7 @@ so threads can simplify different meshes at once.
 """
 
 import ctypes
+import operator
 import os
 from collections import namedtuple
 
@@ -262,34 +263,63 @@ def _as_indices(triangles):
 _TREE_KINDS = {"vstree": 0, "octree": 1}
 _METRICS = {"l2": 0, "l21": 1, "density": 2}
 _SAMPLINGS = {"vertices": 0, "faces": 1, "face_centers": 1}
-_FIELDS = ("error", "d_a", "d_d", "max_depth", "threads", "min_cell_size")
+_ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
+_ENUMS = {"tree_kind": _TREE_KINDS, "metric": _METRICS, "sampling": _SAMPLINGS, "orient": _ORIENTATIONS}
+_C_INTEGERS = {ctypes.c_uint32: ("uint32", 0, 2**32 - 1), ctypes.c_int32: ("int32", -(2**31), 2**31 - 1)}
 
 
-def _params(options):
-    """The C parameter struct from keyword options (the C field names; enums as names)."""
+def _integer(who, key, value, expected="an integer"):
+    """``value`` as a Python int; floats and strings are refused, not truncated (2.7 is not 2)."""
+    try:
+        return operator.index(value)
+    except TypeError:
+        raise TypeError(
+            "%s: parameter `%s`: must be %s, not %r (%s)" % (who, key, expected, value, type(value).__name__)
+        ) from None
+
+
+def _set_options(who, p, options, fields):
+    """Sets the fields of a C parameter struct from keyword options (the C field names; enums
+    by name or number; booleans for flags). ``who`` names the Python function in messages.
+    The library checks each value's range; here, only that it fits the C field's type."""
+    types = dict(p._fields_)
+    for key, value in options.items():
+        if key not in fields:
+            raise TypeError("%s: unknown parameter %r (the parameters are %s)" % (who, key, ", ".join(fields)))
+        c_type = types[key]
+        expected = "an integer"
+        if key in _ENUMS:
+            names = ", ".join(repr(n) for n in sorted(_ENUMS[key]))
+            expected = "one of %s or an integer" % names
+            if isinstance(value, str):
+                if value.lower() not in _ENUMS[key]:
+                    raise ValueError("%s: parameter `%s`: %r is not one of %s" % (who, key, value, names))
+                value = _ENUMS[key][value.lower()]
+        if c_type in _C_INTEGERS:
+            value = _integer(who, key, value, expected)
+            c_name, low, high = _C_INTEGERS[c_type]
+            if not low <= value <= high:
+                raise VstreeError(
+                    Status.INVALID_PARAMETER,
+                    "%s: parameter `%s`: %d is out of range for the C field (%s)" % (who, key, value, c_name),
+                )
+        try:
+            setattr(p, key, value)
+        except TypeError:
+            raise TypeError(
+                "%s: parameter `%s`: must be a real number, not %r (%s)" % (who, key, value, type(value).__name__)
+            ) from None
+    return p
+
+
+_SIMPLIFY_FIELDS = ("error", "tree_kind", "metric", "sampling", "d_a", "d_d", "max_depth", "threads", "min_cell_size")
+
+
+def _params(who, options):
+    """The C parameter struct of simplify and Tree from keyword options."""
     p = lib.vstree_simplify_params_default()
     p.struct_size = ctypes.sizeof(_ffi.SimplifyParams)
-    for key, value in options.items():
-        if key in ("tree_kind", "metric", "sampling"):
-            names = {"tree_kind": _TREE_KINDS, "metric": _METRICS, "sampling": _SAMPLINGS}[key]
-            if isinstance(value, str):
-                if value.lower() not in names:
-                    raise ValueError("%s must be one of %s, not %r" % (key, sorted(names), value))
-                value = names[value.lower()]
-            if not -(2**31) <= int(value) < 2**31:
-                raise VstreeError(
-                    Status.INVALID_PARAMETER, "parameter `%s`: %r is out of range" % (key, value)
-                )
-            setattr(p, key, int(value))
-        elif key in _FIELDS:
-            if key in ("max_depth", "threads") and not 0 <= int(value) <= 0xFFFFFFFF:
-                raise VstreeError(
-                    Status.INVALID_PARAMETER, "parameter `%s`: %r is out of range" % (key, value)
-                )
-            setattr(p, key, value)
-        else:
-            raise TypeError("unknown vstree parameter %r" % key)
-    return p
+    return _set_options(who, p, options, _SIMPLIFY_FIELDS)
 
 
 def _struct_dict(struct):
@@ -337,7 +367,7 @@ def simplify(mesh, progress=None, **params):
     ``progress(fraction, stage)`` is called on this thread; returning False cancels
     (:class:`CancelledError`). Returns ``SimplifyResult(mesh, stats)``.
     """
-    p = _params(params)
+    p = _params("vstree.simplify", params)
     cb = _Progress(progress)
     result = ctypes.c_void_p()
     cb.check(lib.vstree_simplify(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
@@ -362,7 +392,7 @@ class Tree:
     NO_INDEX = 0xFFFFFFFF
 
     def __init__(self, mesh, progress=None, **params):
-        p = _params(params)
+        p = _params("vstree.Tree", params)
         cb = _Progress(progress)
         handle = ctypes.c_void_p()
         cb.check(lib.vstree_tree_build(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(handle)))
@@ -429,9 +459,9 @@ class Tree:
 
 # ---- reconstruction and normal estimation ---------------------------------------------------
 
-_ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
 _RECONSTRUCT_FIELDS = (
     "error",
+    "orient",
     "d_a",
     "d_d",
     "max_depth",
@@ -446,33 +476,7 @@ _RECONSTRUCT_FIELDS = (
     "reorient_given",
     "threads",
 )
-_NORMAL_FIELDS = ("neighbours", "reorient_given", "threads")
-_UNSIGNED = ("max_depth", "max_levels", "max_triangles", "max_grid_depth", "neighbours", "reorient_given", "threads")
-
-
-def _fill(p, options, fields):
-    """Sets the fields of a C parameter struct from keyword options; ``orient`` by name or
-    number; booleans for ``reorient_given``."""
-    for key, value in options.items():
-        if key == "orient":
-            if isinstance(value, str):
-                if value.lower() not in _ORIENTATIONS:
-                    raise ValueError("orient must be one of %s, not %r" % (sorted(_ORIENTATIONS), value))
-                value = _ORIENTATIONS[value.lower()]
-            if not -(2**31) <= int(value) < 2**31:
-                raise VstreeError(Status.INVALID_PARAMETER, "parameter `orient`: %r is out of range" % (value,))
-            p.orient = int(value)
-        elif key in fields:
-            if key in _UNSIGNED:
-                value = int(value)
-                if not 0 <= value <= 0xFFFFFFFF:
-                    raise VstreeError(
-                        Status.INVALID_PARAMETER, "parameter `%s`: %r is out of range" % (key, value)
-                    )
-            setattr(p, key, value)
-        else:
-            raise TypeError("unknown vstree parameter %r" % key)
-    return p
+_NORMAL_FIELDS = ("orient", "neighbours", "reorient_given", "threads")
 
 
 def _cloud(points, normals):
@@ -511,7 +515,7 @@ def reconstruct(cloud, normals=None, progress=None, **params):
     mesh = _cloud(cloud, normals)
     p = lib.vstree_reconstruct_params_default()
     p.struct_size = ctypes.sizeof(_ffi.ReconstructParams)
-    _fill(p, params, _RECONSTRUCT_FIELDS)
+    _set_options("vstree.reconstruct", p, params, _RECONSTRUCT_FIELDS)
     cb = _Progress(progress)
     result = ctypes.c_void_p()
     cb.check(lib.vstree_reconstruct(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
@@ -543,7 +547,7 @@ def estimate_normals(cloud, normals=None, progress=None, **params):
     mesh = _cloud(cloud, normals)
     p = lib.vstree_normal_params_default()
     p.struct_size = ctypes.sizeof(_ffi.NormalParams)
-    _fill(p, params, _NORMAL_FIELDS)
+    _set_options("vstree.estimate_normals", p, params, _NORMAL_FIELDS)
     report = _ffi.NormalsReport()
     report.struct_size = ctypes.sizeof(_ffi.NormalsReport)
     cb = _Progress(progress)
