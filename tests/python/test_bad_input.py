@@ -349,7 +349,100 @@ PARAMETER_CASES = [
          "reorient_given, threads)"),
 ]
 
-CASES = NUL_CASES + CLOSED_CASES + PARAMETER_CASES
+
+# ---- arrays ----------------------------------------------------------------------------------
+
+INPUT = S.INVALID_INPUT
+LINE = np.stack([np.arange(50), 2 * np.arange(50), np.zeros(50)], -1)
+
+
+def mesh_of(positions, triangles=None, normals=None):
+    return lambda c: vstree.Mesh(positions, triangles, normals)
+
+
+ARRAY_CASES = [
+    case("positions-two-columns", mesh_of(P[:, :2]), ValueError, None,
+         "positions must have shape (n, 3), not (128, 2)"),
+    case("positions-three-dimensions", mesh_of(P[None]), ValueError, None,
+         "positions must have shape (n, 3), not (1, 128, 3)"),
+    case("positions-flat-not-a-multiple-of-3", mesh_of(np.zeros(7)), ValueError, None,
+         "positions must have shape (n, 3), not (7,)"),
+    case("positions-strings", mesh_of([["1", "2", "x"]]), TypeError, None,
+         "positions must be real numbers, not <U1"),
+    case("positions-complex", mesh_of(P + 1j), TypeError, None,
+         "positions must be real numbers, not complex64"),
+    case("positions-none", mesh_of(None), TypeError, None,
+         "positions must be an (n, 3) array of numbers, not None"),
+    case("positions-ragged", mesh_of([[0, 0, 0], [1, 1]]), ValueError, None,
+         "positions: setting an array element with a sequence.", False),
+    case("positions-objects", mesh_of([[0, 0, {}]]), TypeError, None,
+         "positions: float() argument must be a string or a real number, not 'dict'"),
+    case("positions-empty", mesh_of(np.zeros((0, 3))), vstree.VstreeError, INPUT,
+         "vstree_mesh_create: `vertex_count` is 0: a mesh needs at least one vertex"),
+    case("positions-empty-list", mesh_of([]), vstree.VstreeError, INPUT,
+         "vstree_mesh_create: `vertex_count` is 0: a mesh needs at least one vertex"),
+    case("positions-nan", mesh_of(with_item(P, (5, 1), np.nan), T), vstree.VstreeError, INPUT,
+         "vstree_mesh_create: invalid input: vertex 5 has a NaN or infinite coordinate"),
+    case("positions-inf", mesh_of(with_item(P, (7, 0), np.inf), T), vstree.VstreeError, INPUT,
+         "vstree_mesh_create: invalid input: vertex 7 has a NaN or infinite coordinate"),
+    case("positions-minus-inf-flat", mesh_of(with_item(P.ravel(), 29, -np.inf)), vstree.VstreeError, INPUT,
+         "vstree_mesh_create: invalid input: vertex 9 has a NaN or infinite coordinate"),
+    case("positions-beyond-1e18", mesh_of(with_item(P, (11, 0), 2e18), T), vstree.VstreeError, INPUT,
+         "vstree_mesh_create: invalid input: vertex 11 has a coordinate of 2e18: at most 1e18 in "
+         "magnitude is supported (32-bit geometry); rescale the input"),
+    case("positions-float64-beyond-float32", mesh_of(with_item(P.astype(np.float64), (12, 2), -1e300), T),
+         vstree.VstreeError, INPUT,
+         "vstree.Mesh: invalid input: vertex 12 has a coordinate of -1e+300: at most 1e18 in "
+         "magnitude is supported (32-bit geometry); rescale the input"),
+    case("triangles-negative", mesh_of(P, T.astype(np.int64) - 1), ValueError, None,
+         "triangle 0 uses vertex -1: indices must be in [0, 2^32 - 1]"),
+    case("triangles-beyond-uint32", mesh_of(P, with_item(T.astype(np.int64), (3, 2), 2**33)), ValueError, None,
+         "triangle 3 uses vertex 8589934592: indices must be in [0, 2^32 - 1]"),
+    case("triangles-past-the-last-vertex", mesh_of(P, with_item(T, (3, 2), 128)), vstree.VstreeError, INPUT,
+         "vstree_mesh_create: invalid input: triangle 3 uses vertex 128, but there are only 128 vertices"),
+    case("triangles-floats", mesh_of(P, T.astype(np.float32)), TypeError, None,
+         "triangles must be integers, not float32"),
+    case("triangles-booleans", mesh_of(P, T > 5), TypeError, None, "triangles must be integers, not bool"),
+    case("triangles-two-columns", mesh_of(P, T[:, :2]), ValueError, None,
+         "triangles must have shape (n, 3), not (256, 2)"),
+    case("triangles-ragged", mesh_of(P, [[0, 1, 2], [0, 1]]), ValueError, None,
+         "triangles: setting an array element with a sequence.", False),
+    case("normals-one-short", mesh_of(P, T, N[:-1]), ValueError, None,
+         "normals has shape (127, 3), positions (128, 3)"),
+    case("normals-two-columns", mesh_of(P, T, N[:, :2]), ValueError, None,
+         "normals must have shape (n, 3), not (128, 2)"),
+    case("normals-nan", mesh_of(P, T, with_item(N, (4, 2), np.nan)), vstree.VstreeError, INPUT,
+         "vstree_mesh_create: invalid input: normal 4 has a NaN or infinite component"),
+    case("normals-float64-beyond-float32", mesh_of(P, T, with_item(N.astype(np.float64), (6, 0), 1e40)),
+         vstree.VstreeError, INPUT,
+         "vstree.Mesh: invalid input: normal 6 has a component of 1e+40, beyond the float32 range"),
+    case("normals-strings", mesh_of(P, T, np.full(P.shape, "0")), TypeError, None,
+         "normals must be real numbers, not <U1"),
+    case("simplify-cloud-without-normals", lambda c: vstree.simplify(vstree.Mesh(P)), vstree.VstreeError, INPUT,
+         "vstree_simplify: invalid input: the point cloud has no normals (estimate them first)"),
+    case("reconstruct-normals-one-short", lambda c: vstree.reconstruct(CLOUD, CLOUD[:-1]), ValueError, None,
+         "normals has shape (199, 3), positions (200, 3)"),
+    case("reconstruct-mesh-and-normals", lambda c: vstree.reconstruct(vstree.Mesh(CLOUD), CLOUD), ValueError, None,
+         "normals are given with the Mesh, not separately"),
+    case("reconstruct-no-points", lambda c: vstree.reconstruct(np.zeros((0, 3))), vstree.VstreeError, INPUT,
+         "vstree_mesh_create: `vertex_count` is 0: a mesh needs at least one vertex"),
+    case("reconstruct-five-points", lambda c: vstree.reconstruct(CLOUD[:5]), vstree.VstreeError, INPUT,
+         "vstree_reconstruct: invalid input: 5 points: at least 10 are needed"),
+    case("reconstruct-points-on-a-line", lambda c: vstree.reconstruct(LINE), vstree.VstreeError, INPUT,
+         "vstree_reconstruct: invalid input: all 50 points lie on one line: no plane to estimate normals from"),
+    case("reconstruct-points-at-one-place", lambda c: vstree.reconstruct(np.ones((50, 3))), vstree.VstreeError,
+         INPUT, "vstree_reconstruct: invalid input: all 50 points are at the same place: no plane to "
+         "estimate normals from"),
+    case("normals-two-points", lambda c: vstree.estimate_normals(CLOUD[:2]), vstree.VstreeError, INPUT,
+         "vstree_estimate_normals: invalid input: 2 points: normals need at least 3"),
+    case("normals-points-on-a-line", lambda c: vstree.estimate_normals(LINE[:20]), vstree.VstreeError, INPUT,
+         "vstree_estimate_normals: invalid input: all 20 points lie on one line: no plane to estimate normals from"),
+    case("normals-points-at-one-place", lambda c: vstree.estimate_normals(np.zeros((20, 3))), vstree.VstreeError,
+         INPUT, "vstree_estimate_normals: invalid input: all 20 points are at the same place: no plane to "
+         "estimate normals from"),
+]
+
+CASES = NUL_CASES + CLOSED_CASES + PARAMETER_CASES + ARRAY_CASES
 
 
 @pytest.mark.parametrize("call, exc, status, message, exact", CASES)
@@ -406,3 +499,13 @@ def test_closing_twice_is_harmless_and_a_closed_object_says_so():
         thing.close()
     assert repr(mesh) == "<vstree.Mesh closed>"
     assert tree.stats == stats and stats["vertices"] == len(P)  # a copy, kept after close()
+
+
+def test_the_limits_themselves_are_accepted():
+    """The edges of the ranges the cases above step over."""
+    big = vstree.Mesh(with_item(P, (11, 0), 1e18), T)
+    assert big.positions[11, 0] == np.float32(1e18)
+    assert vstree.Mesh(P.astype(np.float64), T.astype(np.int64)).triangle_count == len(T)
+    assert vstree.estimate_normals(CLOUD[:3]).report["estimated"] == 3
+    assert vstree.simplify(vstree.Mesh(P, T), max_depth=1, min_cell_size=0.0, d_a=0.0, d_d=1.0).mesh.vertex_count > 0
+    assert vstree.reconstruct(CLOUD, CLOUD, neighbours=256, max_levels=0, max_grid_depth=4).stats["levels"] == 0

@@ -235,8 +235,8 @@ def load(path):
     return Mesh.load(path)
 
 
-def _as_rows(array, dtype, name):
-    a = np.ascontiguousarray(array, dtype=dtype)
+def _rows(a, array, name):
+    """``a`` as (n, 3) rows: flat arrays of 3k values are k rows."""
     if a.ndim == 1 and a.size % 3 == 0:
         a = a.reshape(-1, 3)
     if a.ndim != 2 or a.shape[1] != 3:
@@ -244,18 +244,59 @@ def _as_rows(array, dtype, name):
     return a
 
 
+def _as_rows(array, dtype, name):
+    """(n, 3) float32 rows of ``positions`` or ``normals``. Refused here, with the array's name:
+    None, strings, complex numbers (numpy would drop the imaginary part), objects that do not
+    convert, and finite values too large for float32 (the library would see infinities)."""
+    if array is None:
+        raise TypeError("%s must be an (n, 3) array of numbers, not None" % name)
+    try:  # ragged lists, objects that are not numbers: numpy's reason, with the array's name
+        source = np.asarray(array)
+        if source.dtype.kind not in "USc":
+            with np.errstate(over="ignore"):  # overflow is reported below, with the vertex
+                a = np.ascontiguousarray(source, dtype=dtype)
+    except (TypeError, ValueError) as e:
+        raise type(e)("%s: %s" % (name, e)) from None
+    if source.dtype.kind in "USc":
+        raise TypeError("%s must be real numbers, not %s" % (name, source.dtype))
+    a = _rows(a, array, name)
+    if source.dtype.kind == "f" and source.dtype.itemsize > a.dtype.itemsize:
+        overflow = np.isinf(a) & np.isfinite(source.reshape(a.shape))
+        if overflow.any():
+            row, column = np.argwhere(overflow)[0]
+            value = source.reshape(a.shape)[row, column]
+            if name == "positions":
+                detail = (
+                    "vertex %d has a coordinate of %g: at most 1e18 in magnitude is supported "
+                    "(32-bit geometry); rescale the input" % (row, value)
+                )
+            else:
+                detail = "normal %d has a component of %g, beyond the float32 range" % (row, value)
+            raise VstreeError(Status.INVALID_INPUT, "vstree.Mesh: invalid input: " + detail)
+    return a
+
+
 def _as_indices(triangles):
-    t = np.asarray(triangles)
+    try:
+        t = np.asarray(triangles)
+    except (TypeError, ValueError) as e:
+        raise type(e)("triangles: %s" % e) from None
     if t.size == 0:
         return np.zeros((0, 3), np.uint32)
     if t.dtype.kind not in "ui":
         raise TypeError("triangles must be integers, not %s" % t.dtype)
+    t = _rows(t, triangles, "triangles")
     # Indices of a type wider than uint32, or signed, might not fit: check before converting
     # (the library checks each index against the vertex count anyway).
     fits = t.dtype.kind == "u" and t.dtype.itemsize <= 4
-    if not fits and (t.min() < 0 or t.max() > 0xFFFFFFFF):
-        raise ValueError("triangle indices must be in [0, 2^32 - 1]")
-    return _as_rows(t, np.uint32, "triangles")
+    if not fits:
+        bad = (t < 0) | (t > 0xFFFFFFFF)
+        if bad.any():
+            row, column = np.argwhere(bad)[0]
+            raise ValueError(
+                "triangle %d uses vertex %d: indices must be in [0, 2^32 - 1]" % (row, t[row, column])
+            )
+    return np.ascontiguousarray(t, dtype=np.uint32)
 
 
 # ---- parameters -----------------------------------------------------------------------------
