@@ -442,7 +442,68 @@ ARRAY_CASES = [
          "estimate normals from"),
 ]
 
-CASES = NUL_CASES + CLOSED_CASES + PARAMETER_CASES + ARRAY_CASES
+
+# ---- wrong types and progress callbacks ------------------------------------------------------
+
+CANCELLED = S.CANCELLED
+NOT_A_MESH = "`mesh` must be a vstree.Mesh, not %s (make one with vstree.Mesh(positions, triangles))"
+
+
+class HostGaveUp(Exception):
+    pass
+
+
+def give_up(fraction, stage):
+    raise HostGaveUp("host gave up at %s" % stage)
+
+
+TYPE_CASES = [
+    case("simplify-an-array", lambda c: vstree.simplify(P), TypeError, None,
+         "vstree.simplify: " + NOT_A_MESH % "ndarray"),
+    case("simplify-none", lambda c: vstree.simplify(None), TypeError, None,
+         "vstree.simplify: " + NOT_A_MESH % "NoneType"),
+    case("tree-of-an-array", lambda c: vstree.Tree(P), TypeError, None, "vstree.Tree: " + NOT_A_MESH % "ndarray"),
+    case("tree-vertex-labels-unknown-kind", lambda c: vstree.Tree(c.mesh()).vertex_labels("depth"), ValueError,
+         None, "Tree.vertex_labels: `kind` must be 'cluster' or 't_node', not 'depth'"),
+    case("tree-vertex-labels-number", lambda c: vstree.Tree(c.mesh()).vertex_labels(0), ValueError, None,
+         "Tree.vertex_labels: `kind` must be 'cluster' or 't_node', not 0"),
+    case("load-an-int-path", lambda c: vstree.load(3), TypeError, None,
+         "expected str, bytes or os.PathLike object, not int"),
+    case("save-a-none-path", lambda c: c.mesh().save(None), TypeError, None,
+         "expected str, bytes or os.PathLike object, not NoneType"),
+    case("from-bytes-an-int", lambda c: vstree.Mesh.from_bytes(5, "a.off"), TypeError, None,
+         "Mesh.from_bytes: `data` must be bytes-like (the file's content), not int"),
+    case("from-bytes-a-str", lambda c: vstree.Mesh.from_bytes("OFF\n", "a.off"), TypeError, None,
+         "Mesh.from_bytes: `data` must be bytes-like (the file's content), not str"),
+    case("from-bytes-a-none-name", lambda c: vstree.Mesh.from_bytes(b"OFF\n", None), TypeError, None,
+         "expected str, bytes or os.PathLike object, not NoneType"),
+    case("simplify-progress-not-callable", lambda c: vstree.simplify(c.mesh(), progress=5), TypeError, None,
+         "vstree.simplify: `progress` must be a callable (fraction, stage) -> bool, or None, not 5 (int)"),
+    case("reconstruct-progress-not-callable", lambda c: vstree.reconstruct(CLOUD, progress="log"), TypeError,
+         None, "vstree.reconstruct: `progress` must be a callable (fraction, stage) -> bool, or None, not "
+         "'log' (str)"),
+    case("simplify-progress-returns-false", lambda c: vstree.simplify(c.mesh(), progress=lambda f, s: False),
+         vstree.CancelledError, CANCELLED, "vstree_simplify: cancelled"),
+    case("tree-progress-returns-false", lambda c: vstree.Tree(c.mesh(), progress=lambda f, s: f < 0.5),
+         vstree.CancelledError, CANCELLED, "vstree_tree_build: cancelled"),
+    case("reconstruct-progress-returns-false",
+         lambda c: vstree.reconstruct(CLOUD, CLOUD, progress=lambda f, s: False),
+         vstree.CancelledError, CANCELLED, "vstree_reconstruct: cancelled"),
+    case("normals-progress-returns-false", lambda c: vstree.estimate_normals(CLOUD, progress=lambda f, s: False),
+         vstree.CancelledError, CANCELLED, "vstree_estimate_normals: cancelled"),
+    case("simplify-progress-raises", lambda c: vstree.simplify(c.mesh(), progress=give_up), HostGaveUp, None,
+         "host gave up at building tree"),
+    case("tree-progress-raises", lambda c: vstree.Tree(c.mesh(), progress=give_up), HostGaveUp, None,
+         "host gave up at building tree"),
+    case("reconstruct-progress-raises", lambda c: vstree.reconstruct(CLOUD, CLOUD, progress=give_up), HostGaveUp,
+         None, "host gave up at building tree"),
+    case("normals-progress-raises", lambda c: vstree.estimate_normals(CLOUD, progress=give_up), HostGaveUp, None,
+         "host gave up at normals: k-d tree"),
+    case("simplify-progress-wrong-signature", lambda c: vstree.simplify(c.mesh(), progress=lambda f: True),
+         TypeError, None, "takes 1 positional argument but 2 were given", False),
+]
+
+CASES = NUL_CASES + CLOSED_CASES + PARAMETER_CASES + ARRAY_CASES + TYPE_CASES
 
 
 @pytest.mark.parametrize("call, exc, status, message, exact", CASES)
@@ -509,3 +570,25 @@ def test_the_limits_themselves_are_accepted():
     assert vstree.estimate_normals(CLOUD[:3]).report["estimated"] == 3
     assert vstree.simplify(vstree.Mesh(P, T), max_depth=1, min_cell_size=0.0, d_a=0.0, d_d=1.0).mesh.vertex_count > 0
     assert vstree.reconstruct(CLOUD, CLOUD, neighbours=256, max_levels=0, max_grid_depth=4).stats["levels"] == 0
+
+
+@pytest.mark.parametrize("answer", [False, "raise"])
+def test_a_callback_that_stops_is_not_called_again(answer):
+    calls = []
+
+    def progress(fraction, stage):
+        calls.append((fraction, stage))
+        if answer == "raise":
+            raise HostGaveUp(stage)
+        return False
+
+    expected = vstree.CancelledError if answer is False else HostGaveUp
+    for run in (
+        lambda: vstree.simplify(vstree.Mesh(P, T), progress=progress),
+        lambda: vstree.reconstruct(CLOUD, CLOUD, progress=progress),
+        lambda: vstree.estimate_normals(CLOUD, progress=progress),
+    ):
+        del calls[:]
+        with pytest.raises(expected):
+            run()
+        assert len(calls) == 1, calls

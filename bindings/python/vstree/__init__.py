@@ -150,7 +150,12 @@ class Mesh:
     def from_bytes(cls, data, name):
         """Parses a whole file held in memory; ``name`` ("scan.ply" or "ply"; str, bytes or
         os.PathLike) gives the format."""
-        data = bytes(data)
+        try:  # bytes(5) would be five NUL bytes, bytes("OFF") an unclear TypeError
+            data = memoryview(data).tobytes()
+        except TypeError:
+            raise TypeError(
+                "Mesh.from_bytes: `data` must be bytes-like (the file's content), not %s" % type(data).__name__
+            ) from None
         handle = ctypes.c_void_p()
         _check(lib.vstree_mesh_load_memory(data, len(data), _c_string(name, "name"), ctypes.byref(handle)))
         return cls._wrap(handle.value)
@@ -233,6 +238,16 @@ class Mesh:
 def load(path):
     """Reads a mesh or point cloud: same as :meth:`Mesh.load`."""
     return Mesh.load(path)
+
+
+def _mesh_handle(who, mesh):
+    """The live handle of ``mesh``, which must be a :class:`Mesh` (not an array)."""
+    if not isinstance(mesh, Mesh):
+        raise TypeError(
+            "%s: `mesh` must be a vstree.Mesh, not %s (make one with vstree.Mesh(positions, triangles))"
+            % (who, type(mesh).__name__)
+        )
+    return mesh._live()
 
 
 def _rows(a, array, name):
@@ -375,7 +390,12 @@ class _Progress:
     """Adapts a Python callable ``(fraction, stage) -> bool`` to the C callback. Returning False
     cancels; an exception inside it cancels too and is re-raised from the call."""
 
-    def __init__(self, callback):
+    def __init__(self, who, callback):
+        if callback is not None and not callable(callback):
+            raise TypeError(
+                "%s: `progress` must be a callable (fraction, stage) -> bool, or None, not %r (%s)"
+                % (who, callback, type(callback).__name__)
+            )
         self.callback = callback
         self.error = None
         self.c_function = _ffi.PROGRESS(self._call) if callback is not None else _ffi.PROGRESS()
@@ -409,9 +429,10 @@ def simplify(mesh, progress=None, **params):
     (:class:`CancelledError`). Returns ``SimplifyResult(mesh, stats)``.
     """
     p = _params("vstree.simplify", params)
-    cb = _Progress(progress)
+    handle = _mesh_handle("vstree.simplify", mesh)
+    cb = _Progress("vstree.simplify", progress)
     result = ctypes.c_void_p()
-    cb.check(lib.vstree_simplify(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
+    cb.check(lib.vstree_simplify(handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
     try:
         stats = lib.vstree_simplify_result_get_stats(result).contents
         if stats.struct_size < ctypes.sizeof(_ffi.SimplifyStats):
@@ -434,9 +455,10 @@ class Tree:
 
     def __init__(self, mesh, progress=None, **params):
         p = _params("vstree.Tree", params)
-        cb = _Progress(progress)
+        mesh_handle = _mesh_handle("vstree.Tree", mesh)
+        cb = _Progress("vstree.Tree", progress)
         handle = ctypes.c_void_p()
-        cb.check(lib.vstree_tree_build(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(handle)))
+        cb.check(lib.vstree_tree_build(mesh_handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(handle)))
         self._handle = handle.value
         self.stats = _struct_dict(lib.vstree_tree_get_stats(self._handle).contents)
 
@@ -490,8 +512,8 @@ class Tree:
         """One uint32 per input vertex: its cluster ("cluster") or its T-node's index in
         :attr:`t_nodes` ("t_node"); ``Tree.NO_INDEX`` for none."""
         kinds = {"cluster": 0, "t_node": 1}
-        if kind not in kinds:
-            raise ValueError("kind must be 'cluster' or 't_node', not %r" % (kind,))
+        if not isinstance(kind, str) or kind not in kinds:
+            raise ValueError("Tree.vertex_labels: `kind` must be 'cluster' or 't_node', not %r" % (kind,))
         handle = self._live()
         out = np.empty(lib.vstree_tree_vertex_count(handle), np.uint32)
         _check(lib.vstree_tree_copy_vertex_labels(handle, kinds[kind], out.ctypes.data_as(_ffi._U32P), out.size))
@@ -557,7 +579,7 @@ def reconstruct(cloud, normals=None, progress=None, **params):
     p = lib.vstree_reconstruct_params_default()
     p.struct_size = ctypes.sizeof(_ffi.ReconstructParams)
     _set_options("vstree.reconstruct", p, params, _RECONSTRUCT_FIELDS)
-    cb = _Progress(progress)
+    cb = _Progress("vstree.reconstruct", progress)
     result = ctypes.c_void_p()
     cb.check(lib.vstree_reconstruct(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
     try:
@@ -591,7 +613,7 @@ def estimate_normals(cloud, normals=None, progress=None, **params):
     _set_options("vstree.estimate_normals", p, params, _NORMAL_FIELDS)
     report = _ffi.NormalsReport()
     report.struct_size = ctypes.sizeof(_ffi.NormalsReport)
-    cb = _Progress(progress)
+    cb = _Progress("vstree.estimate_normals", progress)
     out = ctypes.c_void_p()
     cb.check(
         lib.vstree_estimate_normals(
