@@ -12,7 +12,10 @@ through the library's C API with numpy arrays in and out.
     surface.mesh.triangles, surface.stats["base_genus"]
     oriented = vstree.estimate_normals(points)        # a Mesh with normals; .report too
 
-Failures raise :class:`VstreeError` with the C status and the library's message. Depends on
+Failures raise :class:`VstreeError` with the C status and the library's message; arguments
+the binding can judge before calling C raise TypeError or ValueError naming the function and
+the argument (a path with a NUL byte, a closed Mesh or Tree, a float where an integer is
+needed, an unknown enum name), as do arrays numpy cannot convert. Depends on
 numpy and the standard library only (Blender's Python has both). The calls release the GIL,
 so threads can simplify different meshes at once.
 """
