@@ -12,12 +12,16 @@ through the library's C API with numpy arrays in and out.
     surface.mesh.triangles, surface.stats["base_genus"]
     oriented = vstree.estimate_normals(points)        # a Mesh with normals; .report too
 
-Failures raise :class:`VstreeError` with the C status and the library's message. Depends on
+Failures raise :class:`VstreeError` with the C status and the library's message; arguments
+the binding can judge before calling C raise TypeError or ValueError naming the function and
+the argument (a path with a NUL byte, a closed Mesh or Tree, a float where an integer is
+needed, an unknown enum name), as do arrays numpy cannot convert. Depends on
 numpy and the standard library only (Blender's Python has both). The calls release the GIL,
 so threads can simplify different meshes at once.
 """
 
 import ctypes
+import operator
 import os
 from collections import namedtuple
 
@@ -89,8 +93,18 @@ def _check(status):
         raise cls(status, message)
 
 
+def _c_string(value, what):
+    """The bytes of a path or name (str, bytes or os.PathLike) for a NUL-terminated C string.
+    C ends the string at the first NUL, so a path with one in it would name another file
+    ("victim.ply\\0-simplified.ply" would overwrite victim.ply): refuse it, as open() does."""
+    encoded = os.fsencode(value)
+    if b"\0" in encoded:
+        raise ValueError("%s contains an embedded null byte: %r" % (what, os.fspath(value)))
+    return encoded
+
+
 def _path(path):
-    return os.fsencode(path)
+    return _c_string(path, "path")
 
 
 class Mesh:
@@ -137,15 +151,21 @@ class Mesh:
 
     @classmethod
     def from_bytes(cls, data, name):
-        """Parses a whole file held in memory; ``name`` ("scan.ply" or "ply") gives the format."""
-        data = bytes(data)
+        """Parses a whole file held in memory; ``name`` ("scan.ply" or "ply"; str, bytes or
+        os.PathLike) gives the format."""
+        try:  # bytes(5) would be five NUL bytes, bytes("OFF") an unclear TypeError
+            data = memoryview(data).tobytes()
+        except TypeError:
+            raise TypeError(
+                "Mesh.from_bytes: `data` must be bytes-like (the file's content), not %s" % type(data).__name__
+            ) from None
         handle = ctypes.c_void_p()
-        _check(lib.vstree_mesh_load_memory(data, len(data), name.encode(), ctypes.byref(handle)))
+        _check(lib.vstree_mesh_load_memory(data, len(data), _c_string(name, "name"), ctypes.byref(handle)))
         return cls._wrap(handle.value)
 
     def save(self, path, ascii=False):
         """Writes the mesh (format from the extension; atomic: on error the file is unchanged)."""
-        _check(lib.vstree_mesh_save(self._handle, _path(path), 1 if ascii else 0))
+        _check(lib.vstree_mesh_save(self._live(), _path(path), 1 if ascii else 0))
 
     def close(self):
         """Frees the mesh now (it is freed when garbage-collected otherwise)."""
@@ -166,9 +186,12 @@ class Mesh:
         self.close()
 
     def _live(self):
-        if not self._handle:
+        """The handle, for every call that uses it; a closed mesh has none (C would report a
+        NULL pointer instead of saying why)."""
+        handle = getattr(self, "_handle", None)
+        if not handle:
             raise ValueError("the mesh was closed")
-        return self._handle
+        return handle
 
     @property
     def vertex_count(self):
@@ -206,7 +229,7 @@ class Mesh:
         return out
 
     def __repr__(self):
-        if not self._handle:
+        if not getattr(self, "_handle", None):
             return "<vstree.Mesh closed>"
         return "<vstree.Mesh %d vertices, %d triangles%s>" % (
             self.vertex_count,
@@ -220,8 +243,18 @@ def load(path):
     return Mesh.load(path)
 
 
-def _as_rows(array, dtype, name):
-    a = np.ascontiguousarray(array, dtype=dtype)
+def _mesh_handle(who, mesh):
+    """The live handle of ``mesh``, which must be a :class:`Mesh` (not an array)."""
+    if not isinstance(mesh, Mesh):
+        raise TypeError(
+            "%s: `mesh` must be a vstree.Mesh, not %s (make one with vstree.Mesh(positions, triangles))"
+            % (who, type(mesh).__name__)
+        )
+    return mesh._live()
+
+
+def _rows(a, array, name):
+    """``a`` as (n, 3) rows: flat arrays of 3k values are k rows."""
     if a.ndim == 1 and a.size % 3 == 0:
         a = a.reshape(-1, 3)
     if a.ndim != 2 or a.shape[1] != 3:
@@ -229,18 +262,59 @@ def _as_rows(array, dtype, name):
     return a
 
 
+def _as_rows(array, dtype, name):
+    """(n, 3) float32 rows of ``positions`` or ``normals``. Refused here, with the array's name:
+    None, strings, complex numbers (numpy would drop the imaginary part), objects that do not
+    convert, and finite values too large for float32 (the library would see infinities)."""
+    if array is None:
+        raise TypeError("%s must be an (n, 3) array of numbers, not None" % name)
+    try:  # ragged lists, objects that are not numbers: numpy's reason, with the array's name
+        source = np.asarray(array)
+        if source.dtype.kind not in "USc":
+            with np.errstate(over="ignore"):  # overflow is reported below, with the vertex
+                a = np.ascontiguousarray(source, dtype=dtype)
+    except (TypeError, ValueError) as e:
+        raise type(e)("%s: %s" % (name, e)) from None
+    if source.dtype.kind in "USc":
+        raise TypeError("%s must be real numbers, not %s" % (name, source.dtype))
+    a = _rows(a, array, name)
+    if source.dtype.kind == "f" and source.dtype.itemsize > a.dtype.itemsize:
+        overflow = np.isinf(a) & np.isfinite(source.reshape(a.shape))
+        if overflow.any():
+            row, column = np.argwhere(overflow)[0]
+            value = source.reshape(a.shape)[row, column]
+            if name == "positions":
+                detail = (
+                    "vertex %d has a coordinate of %g: at most 1e18 in magnitude is supported "
+                    "(32-bit geometry); rescale the input" % (row, value)
+                )
+            else:
+                detail = "normal %d has a component of %g, beyond the float32 range" % (row, value)
+            raise VstreeError(Status.INVALID_INPUT, "vstree.Mesh: invalid input: " + detail)
+    return a
+
+
 def _as_indices(triangles):
-    t = np.asarray(triangles)
+    try:
+        t = np.asarray(triangles)
+    except (TypeError, ValueError) as e:
+        raise type(e)("triangles: %s" % e) from None
     if t.size == 0:
         return np.zeros((0, 3), np.uint32)
     if t.dtype.kind not in "ui":
         raise TypeError("triangles must be integers, not %s" % t.dtype)
+    t = _rows(t, triangles, "triangles")
     # Indices of a type wider than uint32, or signed, might not fit: check before converting
     # (the library checks each index against the vertex count anyway).
     fits = t.dtype.kind == "u" and t.dtype.itemsize <= 4
-    if not fits and (t.min() < 0 or t.max() > 0xFFFFFFFF):
-        raise ValueError("triangle indices must be in [0, 2^32 - 1]")
-    return _as_rows(t, np.uint32, "triangles")
+    if not fits:
+        bad = (t < 0) | (t > 0xFFFFFFFF)
+        if bad.any():
+            row, column = np.argwhere(bad)[0]
+            raise ValueError(
+                "triangle %d uses vertex %d: indices must be in [0, 2^32 - 1]" % (row, t[row, column])
+            )
+    return np.ascontiguousarray(t, dtype=np.uint32)
 
 
 # ---- parameters -----------------------------------------------------------------------------
@@ -248,34 +322,63 @@ def _as_indices(triangles):
 _TREE_KINDS = {"vstree": 0, "octree": 1}
 _METRICS = {"l2": 0, "l21": 1, "density": 2}
 _SAMPLINGS = {"vertices": 0, "faces": 1, "face_centers": 1}
-_FIELDS = ("error", "d_a", "d_d", "max_depth", "threads", "min_cell_size")
+_ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
+_ENUMS = {"tree_kind": _TREE_KINDS, "metric": _METRICS, "sampling": _SAMPLINGS, "orient": _ORIENTATIONS}
+_C_INTEGERS = {ctypes.c_uint32: ("uint32", 0, 2**32 - 1), ctypes.c_int32: ("int32", -(2**31), 2**31 - 1)}
 
 
-def _params(options):
-    """The C parameter struct from keyword options (the C field names; enums as names)."""
+def _integer(who, key, value, expected="an integer"):
+    """``value`` as a Python int; floats and strings are refused, not truncated (2.7 is not 2)."""
+    try:
+        return operator.index(value)
+    except TypeError:
+        raise TypeError(
+            "%s: parameter `%s`: must be %s, not %r (%s)" % (who, key, expected, value, type(value).__name__)
+        ) from None
+
+
+def _set_options(who, p, options, fields):
+    """Sets the fields of a C parameter struct from keyword options (the C field names; enums
+    by name or number; booleans for flags). ``who`` names the Python function in messages.
+    The library checks each value's range; here, only that it fits the C field's type."""
+    types = dict(p._fields_)
+    for key, value in options.items():
+        if key not in fields:
+            raise TypeError("%s: unknown parameter %r (the parameters are %s)" % (who, key, ", ".join(fields)))
+        c_type = types[key]
+        expected = "an integer"
+        if key in _ENUMS:
+            names = ", ".join(repr(n) for n in sorted(_ENUMS[key]))
+            expected = "one of %s or an integer" % names
+            if isinstance(value, str):
+                if value.lower() not in _ENUMS[key]:
+                    raise ValueError("%s: parameter `%s`: %r is not one of %s" % (who, key, value, names))
+                value = _ENUMS[key][value.lower()]
+        if c_type in _C_INTEGERS:
+            value = _integer(who, key, value, expected)
+            c_name, low, high = _C_INTEGERS[c_type]
+            if not low <= value <= high:
+                raise VstreeError(
+                    Status.INVALID_PARAMETER,
+                    "%s: parameter `%s`: %d is out of range for the C field (%s)" % (who, key, value, c_name),
+                )
+        try:
+            setattr(p, key, value)
+        except TypeError:
+            raise TypeError(
+                "%s: parameter `%s`: must be a real number, not %r (%s)" % (who, key, value, type(value).__name__)
+            ) from None
+    return p
+
+
+_SIMPLIFY_FIELDS = ("error", "tree_kind", "metric", "sampling", "d_a", "d_d", "max_depth", "threads", "min_cell_size")
+
+
+def _params(who, options):
+    """The C parameter struct of simplify and Tree from keyword options."""
     p = lib.vstree_simplify_params_default()
     p.struct_size = ctypes.sizeof(_ffi.SimplifyParams)
-    for key, value in options.items():
-        if key in ("tree_kind", "metric", "sampling"):
-            names = {"tree_kind": _TREE_KINDS, "metric": _METRICS, "sampling": _SAMPLINGS}[key]
-            if isinstance(value, str):
-                if value.lower() not in names:
-                    raise ValueError("%s must be one of %s, not %r" % (key, sorted(names), value))
-                value = names[value.lower()]
-            if not -(2**31) <= int(value) < 2**31:
-                raise VstreeError(
-                    Status.INVALID_PARAMETER, "parameter `%s`: %r is out of range" % (key, value)
-                )
-            setattr(p, key, int(value))
-        elif key in _FIELDS:
-            if key in ("max_depth", "threads") and not 0 <= int(value) <= 0xFFFFFFFF:
-                raise VstreeError(
-                    Status.INVALID_PARAMETER, "parameter `%s`: %r is out of range" % (key, value)
-                )
-            setattr(p, key, value)
-        else:
-            raise TypeError("unknown vstree parameter %r" % key)
-    return p
+    return _set_options(who, p, options, _SIMPLIFY_FIELDS)
 
 
 def _struct_dict(struct):
@@ -290,7 +393,12 @@ class _Progress:
     """Adapts a Python callable ``(fraction, stage) -> bool`` to the C callback. Returning False
     cancels; an exception inside it cancels too and is re-raised from the call."""
 
-    def __init__(self, callback):
+    def __init__(self, who, callback):
+        if callback is not None and not callable(callback):
+            raise TypeError(
+                "%s: `progress` must be a callable (fraction, stage) -> bool, or None, not %r (%s)"
+                % (who, callback, type(callback).__name__)
+            )
         self.callback = callback
         self.error = None
         self.c_function = _ffi.PROGRESS(self._call) if callback is not None else _ffi.PROGRESS()
@@ -323,10 +431,11 @@ def simplify(mesh, progress=None, **params):
     ``progress(fraction, stage)`` is called on this thread; returning False cancels
     (:class:`CancelledError`). Returns ``SimplifyResult(mesh, stats)``.
     """
-    p = _params(params)
-    cb = _Progress(progress)
+    p = _params("vstree.simplify", params)
+    handle = _mesh_handle("vstree.simplify", mesh)
+    cb = _Progress("vstree.simplify", progress)
     result = ctypes.c_void_p()
-    cb.check(lib.vstree_simplify(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
+    cb.check(lib.vstree_simplify(handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
     try:
         stats = lib.vstree_simplify_result_get_stats(result).contents
         if stats.struct_size < ctypes.sizeof(_ffi.SimplifyStats):
@@ -348,10 +457,11 @@ class Tree:
     NO_INDEX = 0xFFFFFFFF
 
     def __init__(self, mesh, progress=None, **params):
-        p = _params(params)
-        cb = _Progress(progress)
+        p = _params("vstree.Tree", params)
+        mesh_handle = _mesh_handle("vstree.Tree", mesh)
+        cb = _Progress("vstree.Tree", progress)
         handle = ctypes.c_void_p()
-        cb.check(lib.vstree_tree_build(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(handle)))
+        cb.check(lib.vstree_tree_build(mesh_handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(handle)))
         self._handle = handle.value
         self.stats = _struct_dict(lib.vstree_tree_get_stats(self._handle).contents)
 
@@ -372,11 +482,16 @@ class Tree:
     def __exit__(self, *exc):
         self.close()
 
-    def _copy(self, struct, count, copy):
-        if not self._handle:
+    def _live(self):
+        handle = getattr(self, "_handle", None)
+        if not handle:
             raise ValueError("the tree was closed")
-        out = np.zeros(count(self._handle), dtype=np.dtype(struct))
-        _check(copy(self._handle, out.ctypes.data_as(ctypes.POINTER(struct)), out.size))
+        return handle
+
+    def _copy(self, struct, count, copy):
+        handle = self._live()
+        out = np.zeros(count(handle), dtype=np.dtype(struct))
+        _check(copy(handle, out.ctypes.data_as(ctypes.POINTER(struct)), out.size))
         return out
 
     @property
@@ -400,20 +515,19 @@ class Tree:
         """One uint32 per input vertex: its cluster ("cluster") or its T-node's index in
         :attr:`t_nodes` ("t_node"); ``Tree.NO_INDEX`` for none."""
         kinds = {"cluster": 0, "t_node": 1}
-        if kind not in kinds:
-            raise ValueError("kind must be 'cluster' or 't_node', not %r" % (kind,))
-        if not self._handle:
-            raise ValueError("the tree was closed")
-        out = np.empty(lib.vstree_tree_vertex_count(self._handle), np.uint32)
-        _check(lib.vstree_tree_copy_vertex_labels(self._handle, kinds[kind], out.ctypes.data_as(_ffi._U32P), out.size))
+        if not isinstance(kind, str) or kind not in kinds:
+            raise ValueError("Tree.vertex_labels: `kind` must be 'cluster' or 't_node', not %r" % (kind,))
+        handle = self._live()
+        out = np.empty(lib.vstree_tree_vertex_count(handle), np.uint32)
+        _check(lib.vstree_tree_copy_vertex_labels(handle, kinds[kind], out.ctypes.data_as(_ffi._U32P), out.size))
         return out
 
 
 # ---- reconstruction and normal estimation ---------------------------------------------------
 
-_ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
 _RECONSTRUCT_FIELDS = (
     "error",
+    "orient",
     "d_a",
     "d_d",
     "max_depth",
@@ -428,33 +542,7 @@ _RECONSTRUCT_FIELDS = (
     "reorient_given",
     "threads",
 )
-_NORMAL_FIELDS = ("neighbours", "reorient_given", "threads")
-_UNSIGNED = ("max_depth", "max_levels", "max_triangles", "max_grid_depth", "neighbours", "reorient_given", "threads")
-
-
-def _fill(p, options, fields):
-    """Sets the fields of a C parameter struct from keyword options; ``orient`` by name or
-    number; booleans for ``reorient_given``."""
-    for key, value in options.items():
-        if key == "orient":
-            if isinstance(value, str):
-                if value.lower() not in _ORIENTATIONS:
-                    raise ValueError("orient must be one of %s, not %r" % (sorted(_ORIENTATIONS), value))
-                value = _ORIENTATIONS[value.lower()]
-            if not -(2**31) <= int(value) < 2**31:
-                raise VstreeError(Status.INVALID_PARAMETER, "parameter `orient`: %r is out of range" % (value,))
-            p.orient = int(value)
-        elif key in fields:
-            if key in _UNSIGNED:
-                value = int(value)
-                if not 0 <= value <= 0xFFFFFFFF:
-                    raise VstreeError(
-                        Status.INVALID_PARAMETER, "parameter `%s`: %r is out of range" % (key, value)
-                    )
-            setattr(p, key, value)
-        else:
-            raise TypeError("unknown vstree parameter %r" % key)
-    return p
+_NORMAL_FIELDS = ("orient", "neighbours", "reorient_given", "threads")
 
 
 def _cloud(points, normals):
@@ -493,8 +581,8 @@ def reconstruct(cloud, normals=None, progress=None, **params):
     mesh = _cloud(cloud, normals)
     p = lib.vstree_reconstruct_params_default()
     p.struct_size = ctypes.sizeof(_ffi.ReconstructParams)
-    _fill(p, params, _RECONSTRUCT_FIELDS)
-    cb = _Progress(progress)
+    _set_options("vstree.reconstruct", p, params, _RECONSTRUCT_FIELDS)
+    cb = _Progress("vstree.reconstruct", progress)
     result = ctypes.c_void_p()
     cb.check(lib.vstree_reconstruct(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
     try:
@@ -525,10 +613,10 @@ def estimate_normals(cloud, normals=None, progress=None, **params):
     mesh = _cloud(cloud, normals)
     p = lib.vstree_normal_params_default()
     p.struct_size = ctypes.sizeof(_ffi.NormalParams)
-    _fill(p, params, _NORMAL_FIELDS)
+    _set_options("vstree.estimate_normals", p, params, _NORMAL_FIELDS)
     report = _ffi.NormalsReport()
     report.struct_size = ctypes.sizeof(_ffi.NormalsReport)
-    cb = _Progress(progress)
+    cb = _Progress("vstree.estimate_normals", progress)
     out = ctypes.c_void_p()
     cb.check(
         lib.vstree_estimate_normals(
