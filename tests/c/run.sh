@@ -23,7 +23,7 @@ build="$PWD/target/capi-tests"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 rm -rf "$prefix" "$build"
-mkdir -p "$build" "$tmp/dir.ply"
+mkdir -p "$build" "$tmp/dir.ply" "$tmp/bad-input"
 bash bindings/install.sh "$prefix" >/dev/null
 export PKG_CONFIG_PATH="$prefix/lib/pkgconfig"
 export LD_LIBRARY_PATH="$prefix/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
@@ -66,6 +66,7 @@ for std in c++11 c++17; do
 done
 cc -std=c99 $warn -DEXPECTED_VERSION="\"$version\"" $cflags tests/c/test_api.c $libs -lm \
     -o "$build/test_api"
+cc -std=c99 $warn $cflags tests/c/test_bad_input.c $libs -lm -o "$build/test_bad_input"
 cc -std=c99 $warn -pthread $cflags tests/c/test_threads.c $libs -lm -o "$build/test_threads"
 c++ -std=c++11 $warn $cflags tests/c/test_cpp.cpp $libs -o "$build/test_cpp"
 cc -std=c99 $warn $cflags bindings/c/example.c $libs -o "$build/example"
@@ -77,6 +78,7 @@ memcheck() {
 
 echo "-- run under valgrind"
 memcheck "$build/test_api" "$tmp"
+memcheck "$build/test_bad_input" "$tmp/bad-input"
 memcheck "$build/test_threads"
 memcheck "$build/test_cpp" "$tmp"
 memcheck "$build/example" "$tmp/out.ply" "$tmp/example-out.obj" 5e-3 2>"$tmp/example.log" \
