@@ -229,7 +229,7 @@ impl KdTree {
     /// Checks `k` for [`KdTree::knn_all`]-style queries (each point's `k` other points).
     pub(crate) fn check_k(&self, k: usize) -> Result<()> {
         if k == 0 || k > MAX_K {
-            return Err(Error::param("k", format!("{k} is not in 1..={MAX_K}")));
+            return Err(Error::param("k", format!("{k}: must be from 1 to {MAX_K}")));
         }
         if k >= self.len() {
             return Err(Error::input(format!("{} points: each needs {k} other points as neighbours", self.len())));

@@ -119,7 +119,7 @@ impl NormalParams {
         if !(MIN_NEIGHBOURS..=MAX_NEIGHBOURS).contains(&self.neighbours) {
             return Err(Error::param(
                 "neighbours",
-                format!("{} is not in {MIN_NEIGHBOURS}..={MAX_NEIGHBOURS}", self.neighbours),
+                format!("{}: must be from {MIN_NEIGHBOURS} to {MAX_NEIGHBOURS}", self.neighbours),
             ));
         }
         Ok(())

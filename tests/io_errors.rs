@@ -73,8 +73,8 @@ fn ascii_ply(body: &str) -> Vec<u8> {
 fn truncated_binary_ply_names_the_item() {
     let good = binary_triangles([[0, 1, 2], [2, 1, 0]], 0.0);
     io::ply::parse(&good, Path::new("bad.ply")).unwrap();
-    expect_at(ply(&good[..good.len() - 2]), "face 1", "file ends in face 1 of 2");
-    expect_at(ply(&good[..TRIANGLE_HEADER.len() + 13]), "vertex 1", "file ends in vertex 1 of 3");
+    expect_at(ply(&good[..good.len() - 2]), "face 1", "file ends after 1 of the 2 `face` elements");
+    expect_at(ply(&good[..TRIANGLE_HEADER.len() + 13]), "vertex 1", "file ends after 1 of the 3 `vertex` elements");
 }
 
 #[test]
@@ -142,7 +142,7 @@ fn absurd_counts_in_tiny_files_fail_fast() {
         end_header\n0 0 0\n0 0 0\n0 0 0\n4294967295 0 1 2\n";
     expect_at(ply(ascii), "line 13", "face 0: expected 4294967296 values, found 4");
     let (_, message) = off("OFF\n4000000000 4000000000 0\n0 0 0\n");
-    assert!(message.contains("file ends in vertex 1 of 4000000000"), "{message}");
+    assert!(message.contains("file ends after 1 of the 4000000000 `vertex` elements"), "{message}");
     // Elements without properties occupy no bytes, whatever their count.
     let empty = b"ply\nformat binary_big_endian 1.0\nelement vertex 0\nproperty float x\n\
         property float y\nproperty float z\nelement nothing 1000000000000000000\nend_header\n";
@@ -284,7 +284,10 @@ fn ascii_ply_tolerates_blank_lines_trailing_spaces_and_crlf() {
         ply(&ascii_ply("0 0 0\n\n\r\n1 0 0 5\n0 1 0\n3 0 1 2\n")),
         at("line 13", "vertex 1: expected 3 values, found 4")
     );
-    assert_eq!(ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n\n\n")), at("line 12", "file ends in face 0 of 1"));
+    assert_eq!(
+        ply(&ascii_ply("0 0 0\n1 0 0\n0 1 0\n\n\n")),
+        at("line 12", "file ends after 0 of the 1 `face` elements")
+    );
 }
 
 #[test]

@@ -58,8 +58,9 @@ fn triples<T: Copy, U: Copy>(flat: &[T], what: &str) -> FfiResult<Vec<U>> {
 /// them and may free them when the call returns). The new handle is written to `*out_mesh`
 /// and belongs to the caller, who frees it with vstree_mesh_free().
 ///
-/// - `positions`: 3 × `vertex_count` floats, x y z per vertex. `vertex_count` must be at
-///   least 1 and at most 2^32 - 1.
+/// - `positions`: 3 × `vertex_count` floats, x y z per vertex, finite and at most 1e18 in
+///   magnitude (squares of coordinate differences must fit a float). `vertex_count` must be
+///   at least 1 and at most 2^32 - 1.
 /// - `normals`: NULL, or 3 × `vertex_count` floats, one normal per vertex (any length but
 ///   zero; they are normalised where used). Point clouds need normals to be simplified.
 /// - `triangles`: 3 × `triangle_count` vertex indices (counter-clockwise seen from outside;
@@ -69,7 +70,7 @@ fn triples<T: Copy, U: Copy>(flat: &[T], what: &str) -> FfiResult<Vec<U>> {
 /// Fails with VSTREE_STATUS_NULL_POINTER (a needed array or `out_mesh` is NULL),
 /// VSTREE_STATUS_TOO_LARGE (a count beyond the limits), VSTREE_STATUS_INVALID_ARGUMENT (an
 /// array misaligned for its type), VSTREE_STATUS_INVALID_INPUT (no vertex, a NaN or infinite
-/// coordinate or normal, an index out of range; the message names the first one) or
+/// coordinate or normal, a coordinate beyond 1e18, an index out of range; the message names the first one) or
 /// VSTREE_STATUS_OUT_OF_MEMORY. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_mesh_create(
@@ -167,8 +168,8 @@ pub unsafe extern "C" fn vstree_mesh_load_memory(
     guard("vstree_mesh_load_memory", || {
         non_null(out_mesh, "out_mesh")?;
         let name = unsafe { path_arg(name, "name") }?;
-        // "scan.ply" names itself; a bare "ply" becomes "memory.ply" in messages.
-        let name = match Format::from_path(&name) {
+        // "scan.ply" (or "part.step") names itself; a bare "ply" becomes "memory.ply".
+        let name = match name.extension() {
             Some(_) => name,
             None => Path::new("memory").with_extension(&name),
         };

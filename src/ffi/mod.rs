@@ -55,7 +55,8 @@ pub enum vstree_status {
     /// A field of a parameter struct is outside its documented range; the message names the
     /// field, its value and the range.
     InvalidParameter = 3,
-    /// The geometry cannot be processed: no vertices, a NaN or infinite coordinate, a triangle
+    /// The geometry cannot be processed: no vertices, a NaN, infinite or too large (beyond 1e18)
+    /// coordinate, a triangle
     /// index out of range, a point cloud without normals, only degenerate triangles. The
     /// message names the first offending element.
     InvalidInput = 4,

@@ -55,12 +55,20 @@ impl Format {
         if self != Format::Ply {
             input::refuse_binary(bytes.get(..input::PREFIX_BYTES).unwrap_or(bytes), path)?;
         }
-        match self {
+        let mesh = match self {
             Format::Ply => ply::parse(bytes, path),
             Format::Obj => obj::parse(bytes, path),
             Format::Off => off::parse(bytes, path),
             Format::Xyz => xyz::parse(bytes, path),
+        }?;
+        // Valid in the formats, but nothing any stage can work on, nor a mesh the C API can make.
+        if mesh.positions.is_empty() {
+            return Err(Error::input(format!(
+                "{}: no vertices: the file holds neither a mesh nor points",
+                path.display()
+            )));
         }
+        Ok(mesh)
     }
 
     /// Checks the first bytes of a file before the rest is read, so that a file of another
@@ -129,6 +137,10 @@ impl OutputFile {
     /// Writes `mesh` (which must pass [`Mesh::check`]) and puts it in place of the target.
     pub fn write(self, mesh: &Mesh, options: &WriteOptions) -> Result<()> {
         mesh.check()?;
+        if mesh.positions.is_empty() {
+            // Such a file reads back as an error (see `Format::parse`): never write one.
+            return Err(Error::input("the mesh has no vertices: there is nothing to write"));
+        }
         let format = self.format;
         self.reserved.fill(|out| match format {
             Format::Ply => ply::write(out, mesh, options.ascii),

@@ -44,7 +44,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     let mut normals = has_normals.then(|| Vec::with_capacity(positions.capacity()));
     let columns = if has_normals { 6 } else { 3 };
     for i in 0..vertex_count {
-        let (n, line) = next(&|| format!("file ends in vertex {i} of {vertex_count}"))?;
+        let (n, line) = next(&|| format!("file ends after {i} of the {vertex_count} vertices"))?;
         let values = numbers(&line, columns).map_err(|m| at(n, format!("vertex {i}: {m}")))?;
         let p = Vec3::new(values[0], values[1], values[2]);
         positions.push(assemble::finite_position(p).map_err(|m| at(n, format!("vertex {i}: {m}")))?);
@@ -57,7 +57,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     let mut triangles = Vec::with_capacity(assemble::capacity(face_count, bytes.len(), 8));
     let mut polygon = Vec::new();
     for i in 0..face_count {
-        let (n, line) = next(&|| format!("file ends in face {i} of {face_count}"))?;
+        let (n, line) = next(&|| format!("file ends after {i} of the {face_count} faces"))?;
         read_face(&line, vertex_count, &mut polygon)
             .and_then(|()| assemble::push_fan(&polygon, &mut triangles))
             .map_err(|m| at(n, format!("face {i}: {m}")))?;
@@ -165,7 +165,7 @@ mod tests {
         let err = parse_str("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n").unwrap_err().to_string();
         assert!(err.contains("line 6") && err.contains("face 0") && err.contains("vertex 7"), "{err}");
         let err = parse_str("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").unwrap_err().to_string();
-        assert!(err.contains("file ends in face 1 of 2"), "{err}");
+        assert!(err.contains("file ends after 1 of the 2 faces"), "{err}");
         let err = parse_str("PLY\n").unwrap_err().to_string();
         assert!(err.contains("expected OFF"), "{err}");
     }

@@ -136,16 +136,19 @@ impl ReconstructParams {
             return Err(Error::param("target_distance", format!("{}: must be >= 0", self.target_distance)));
         }
         if self.max_levels > 12 {
-            return Err(Error::param("max_levels", format!("{}: must be in 0..=12", self.max_levels)));
+            return Err(Error::param("max_levels", format!("{}: must be from 0 to 12", self.max_levels)));
         }
         if !(0.0..=1.0).contains(&self.min_displaced) {
             return Err(Error::param("min_displaced", format!("{}: must be in [0, 1]", self.min_displaced)));
         }
         if self.max_triangles == 0 || self.max_triangles > u32::MAX as usize {
-            return Err(Error::param("max_triangles", format!("{}: must be in 1..=2^32-1", self.max_triangles)));
+            return Err(Error::param(
+                "max_triangles",
+                format!("{}: must be from 1 to {}", self.max_triangles, u32::MAX),
+            ));
         }
         if !(4..=20).contains(&self.max_grid_depth) {
-            return Err(Error::param("max_grid_depth", format!("{}: must be in 4..=20", self.max_grid_depth)));
+            return Err(Error::param("max_grid_depth", format!("{}: must be from 4 to 20", self.max_grid_depth)));
         }
         if !(self.trim.is_finite() && self.trim >= 0.0) {
             return Err(Error::param("trim", format!("{}: must be >= 0", self.trim)));

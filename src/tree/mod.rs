@@ -102,7 +102,7 @@ impl TreeParams {
             return Err(Error::param("d_d", format!("{}: must be in [0, 1]", self.d_d)));
         }
         if !(1..=MAX_DEPTH).contains(&self.max_depth) {
-            return Err(Error::param("max_depth", format!("{}: must be in 1..={MAX_DEPTH}", self.max_depth)));
+            return Err(Error::param("max_depth", format!("{}: must be from 1 to {MAX_DEPTH}", self.max_depth)));
         }
         if !(self.min_cell_size.is_finite() && (0.0..1.0).contains(&self.min_cell_size)) {
             return Err(Error::param("min_cell_size", format!("{}: must be in [0, 1)", self.min_cell_size)));

@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <vstree.h>
 
@@ -935,9 +936,118 @@ typedef struct bad_case {
   const char *message; /* exact; "{dir}" = TEMP_DIR, '*' = any run of characters */
 } bad_case;
 
+
+/* ---- results that would be empty or wrong, files that are not regular, outputs that must not
+ * be replaced ---- */
+SIMPLIFY_PARAM(simplify_error_whole_model, error, 100.0)
+CALL(simplify_l21_above_4) {
+  vstree_simplify_params p = vstree_simplify_params_default();
+  p.metric = VSTREE_METRIC_L21;
+  p.error = 5.0;
+  return simplify_with(g_mesh, &p);
+}
+RECONSTRUCT_PARAM(reconstruct_max_depth_1, max_depth, 1)
+RECONSTRUCT_PARAM(reconstruct_error_1e300, error, 1e300)
+CALL(reconstruct_flat_cloud) {
+  static float flat[3 * 40], up[3 * 40];
+  vstree_mesh *m = NULL;
+  vstree_status s;
+  vstree_reconstruct_params p = quick_reconstruct();
+  size_t k;
+  for (k = 0; k < 40; k++) {
+    flat[3 * k] = (float)(k % 7);
+    flat[3 * k + 1] = (float)(k / 7);
+    flat[3 * k + 2] = 0.0f;
+    up[3 * k] = 0.0f;
+    up[3 * k + 1] = 0.0f;
+    up[3 * k + 2] = 1.0f;
+  }
+  if (vstree_mesh_create(flat, 40, up, NULL, 0, &m) != VSTREE_STATUS_OK) {
+    problem("cannot make the flat fixture");
+    return VSTREE_STATUS_OK;
+  }
+  s = reconstruct_with(m, &p);
+  vstree_mesh_free(m);
+  return s;
+}
+/* Makes TEMP_DIR/name a FIFO (or a link to `target`), once. */
+static void special(const char *name, const char *target) {
+  char path[4096];
+  snprintf(path, sizeof path, "%s/%s", g_dir, name);
+  if ((target ? symlink(target, path) : mkfifo(path, 0600)) != 0 && errno != EEXIST) {
+    problem("cannot make the special file");
+  }
+}
+CALL(load_fifo) {
+  special("pipe.ply", NULL);
+  return load("pipe.ply");
+}
+CALL(load_char_device) {
+  special("zero.ply", "/dev/zero");
+  return load("zero.ply");
+}
+CALL(load_zeros) {
+  static const char zeros[4096];
+  write_file("zeros.xyz", zeros, sizeof zeros);
+  return load("zeros.xyz");
+}
+CALL(load_with_bom) { return load_text("bom.off", "\xEF\xBB\xBFOFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"); }
+CALL(load_no_vertices) { return load_text("none.off", "OFF\n0 0 0\n"); }
+CALL(load_obj_two_corner_face) { return load_text("line.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"); }
+CALL(save_to_fifo) {
+  special("out-pipe.ply", NULL);
+  return save(g_mesh, "out-pipe.ply", 0);
+}
+CALL(save_to_char_device) {
+  special("null.ply", "/dev/null");
+  return save(g_mesh, "null.ply", 0);
+}
+CALL(save_through_dangling_link) {
+  special("dangling.ply", "no-such-dir/target.ply");
+  return save(g_mesh, "dangling.ply", 0);
+}
+CALL(save_into_missing_folder) { return save(g_mesh, "no-such-dir/out.ply", 0); }
+CALL(save_over_directory) { return save(g_mesh, "sub.ply", 0); }
+
 #define ROW(call, status, message) {#call, call, VSTREE_STATUS_##status, message}
 
 static const bad_case g_cases[] = {
+    ROW(simplify_error_whole_model, INVALID_PARAMETER, "vstree_simplify: parameter `error`: 100: every triangle collapsed (1 cluster "
+        "for the whole model): the model is within this bound of too few planes; use a "
+        "smaller bound (a flat model, within any bound of one plane, needs the density "
+        "metric)"),
+    ROW(simplify_l21_above_4, INVALID_PARAMETER,
+        "vstree_simplify: parameter `error`: 5: the L2,1 bound must be in (0, 4]"),
+    ROW(reconstruct_max_depth_1, INVALID_PARAMETER, "vstree_reconstruct: parameter `max_depth`: 1: the tree reached this depth "
+        "before any cell saw the surface as a height field, so there is nothing to make "
+        "the base mesh from; allow a deeper tree (default 24)"),
+    ROW(reconstruct_error_1e300, INVALID_PARAMETER, "vstree_reconstruct: parameter `error`: 1e300: the cloud fits this bound in 1 "
+        "octree cell too coarse to see the surface as a height field, so there is "
+        "nothing to make the base mesh from; use a smaller bound (default 1e-5)"),
+    ROW(reconstruct_flat_cloud, INVALID_INPUT, "vstree_reconstruct: invalid input: all 40 points lie in one plane (thickness 0 "
+        "of the cloud's extent): they enclose no volume, so there is no closed surface "
+        "to reconstruct"),
+    ROW(load_fifo, IO, "vstree_mesh_load: {dir}/pipe.ply: a FIFO (named pipe), not a regular file: "
+        "vstree reads meshes from regular files only"),
+    ROW(load_char_device, IO, "vstree_mesh_load: {dir}/zero.ply: a character device, not a regular file: "
+        "vstree reads meshes from regular files only"),
+    ROW(load_zeros, PARSE, "vstree_mesh_load: {dir}/zeros.xyz: line 1: a NUL byte: this is binary data, not "
+        "a text file"),
+    ROW(load_with_bom, OK, ""),
+    ROW(load_no_vertices, INVALID_INPUT, "vstree_mesh_load: invalid input: {dir}/none.off: no vertices: the file holds "
+        "neither a mesh nor points"),
+    ROW(load_obj_two_corner_face, PARSE, "vstree_mesh_load: {dir}/line.obj: line 4: a face with 2 corners: a face needs "
+        "at least 3 (a line is written with `l`)"),
+    ROW(save_to_fifo, IO, "vstree_mesh_save: {dir}/out-pipe.ply: a FIFO (named pipe), not a regular file: "
+        "vstree replaces regular files only"),
+    ROW(save_to_char_device, IO, "vstree_mesh_save: {dir}/null.ply: a character device, not a regular file: "
+        "vstree replaces regular files only"),
+    ROW(save_through_dangling_link, IO, "vstree_mesh_save: {dir}/dangling.ply: a symbolic link to a missing file: not "
+        "writing through a dangling link"),
+    ROW(save_into_missing_folder, IO, "vstree_mesh_save: {dir}/no-such-dir/out.ply: No such file or directory (os "
+        "error 2)"),
+    ROW(save_over_directory, IO, "vstree_mesh_save: {dir}/sub.ply: a directory, not a regular file: vstree "
+        "replaces regular files only"),
     ROW(create_out_null, NULL_POINTER, "vstree_mesh_create: `out_mesh` is NULL"),
     ROW(create_positions_null, NULL_POINTER, "vstree_mesh_create: `positions` is NULL"),
     ROW(create_triangles_null, NULL_POINTER, "vstree_mesh_create: `triangles` is NULL"),
@@ -1003,7 +1113,8 @@ static const bad_case g_cases[] = {
     ROW(load_path_empty, INVALID_ARGUMENT, "vstree_mesh_load: `path`: the path is empty"),
     ROW(load_missing, IO,
         "vstree_mesh_load: {dir}/missing.ply: No such file or directory (os error 2)"),
-    ROW(load_directory, IO, "vstree_mesh_load: {dir}/sub.ply: Is a directory (os error 21)"),
+    ROW(load_directory, IO, "vstree_mesh_load: {dir}/sub.ply: a directory, not a regular file: vstree reads meshes from "
+        "regular files only"),
     ROW(load_unsupported_extension, UNSUPPORTED_FORMAT,
         "vstree_mesh_load: {dir}/mesh.stl: unsupported file format (expected .ply, .obj, .off, "
         ".xyz or .pwn)"),
@@ -1019,7 +1130,8 @@ static const bad_case g_cases[] = {
     ROW(load_ply_no_end_header, PARSE,
         "vstree_mesh_load: {dir}/noend.ply: header: file ends before `end_header`"),
     ROW(load_ply_truncated, PARSE,
-        "vstree_mesh_load: {dir}/truncated.ply: line 9: file ends in vertex 2 of 3"),
+        "vstree_mesh_load: {dir}/truncated.ply: line 9: file ends after 2 of the 3 `vertex` "
+        "elements"),
     ROW(load_ply_bad_number, PARSE,
         "vstree_mesh_load: {dir}/number.ply: line 9: vertex 1: expected a number, found `zero`"),
     ROW(load_ply_face_out_of_range, PARSE,
@@ -1028,22 +1140,23 @@ static const bad_case g_cases[] = {
     ROW(load_ply_no_xyz, PARSE,
         "vstree_mesh_load: {dir}/noxyz.ply: line 3: the vertex element has no scalar `z` property"),
     ROW(load_ply_binary_truncated, PARSE,
-        "vstree_mesh_load: {dir}/binary.ply: vertex 1: file ends in vertex 1 of 2"),
+        "vstree_mesh_load: {dir}/binary.ply: vertex 1: file ends after 1 of the 2 `vertex` "
+        "elements"),
     ROW(load_off_bad_header, PARSE,
         "vstree_mesh_load: {dir}/header.off: line 1: expected OFF, NOFF or COFF, found `OFX`"),
     ROW(load_off_bad_counts, PARSE,
         "vstree_mesh_load: {dir}/counts.off: line 2: expected a number, found `x`"),
     ROW(load_off_truncated, PARSE,
-        "vstree_mesh_load: {dir}/short.off: line 4: file ends in vertex 2 of 3"),
+        "vstree_mesh_load: {dir}/short.off: line 4: file ends after 2 of the 3 vertices"),
     ROW(load_off_out_of_range, PARSE,
         "vstree_mesh_load: {dir}/range.off: line 6: face 0: uses vertex 7, but there are only 3 "
         "vertices"),
     ROW(load_off_nan, PARSE,
         "vstree_mesh_load: {dir}/nan.off: line 4: vertex 1: has a NaN or infinite coordinate "
         "(NaN, 0, 0)"),
-    ROW(load_off_huge_coordinate, INVALID_INPUT,
-        "vstree_mesh_load: invalid input: vertex 1 has a coordinate of 1e19: at most 1e18 in "
-        "magnitude is supported (32-bit geometry); rescale the input"),
+    ROW(load_off_huge_coordinate, PARSE,
+        "vstree_mesh_load: {dir}/huge.off: line 4: vertex 1: has a coordinate of 1e19: at most "
+        "1e18 in magnitude is supported (32-bit geometry); rescale the input"),
     ROW(load_obj_short_vertex, PARSE,
         "vstree_mesh_load: {dir}/short.obj: line 2: expected 3 numbers, found 2"),
     ROW(load_obj_bad_number, PARSE,
@@ -1074,7 +1187,7 @@ static const bad_case g_cases[] = {
         "vstree_mesh_load_memory: memory.stl: unsupported file format (expected .ply, .obj, "
         ".off, .xyz or .pwn)"),
     ROW(memory_name_unsupported_file, UNSUPPORTED_FORMAT,
-        "vstree_mesh_load_memory: memory.part.step: unsupported file format (expected .ply, "
+        "vstree_mesh_load_memory: part.step: unsupported file format (expected .ply, "
         ".obj, .off, .xyz or .pwn)"),
     ROW(memory_size_huge, TOO_LARGE,
         "vstree_mesh_load_memory: `size` is 18446744073709551615, more than any buffer can hold"),
@@ -1083,7 +1196,8 @@ static const bad_case g_cases[] = {
         "vstree_mesh_load_memory: scan.ply: line 1: not a PLY file: it must start with a `ply` "
         "line"),
     ROW(memory_nul_in_off, PARSE,
-        "vstree_mesh_load_memory: memory.off: line 4: vertex 1: expected a number, found `0\\0`"),
+        "vstree_mesh_load_memory: memory.off: line 4: a NUL byte: this is binary data, not a text "
+        "file"),
     ROW(memory_invalid_utf8_obj, PARSE,
         "vstree_mesh_load_memory: memory.obj: line 3: expected a number, found "
         "`\xef\xbf\xbd\xef\xbf\xbd`"),
@@ -1196,11 +1310,11 @@ static const bad_case g_cases[] = {
     ROW(simplify_d_d_nan, INVALID_PARAMETER,
         "vstree_simplify: parameter `d_d`: NaN: must be in [0, 1]"),
     ROW(simplify_max_depth_zero, INVALID_PARAMETER,
-        "vstree_simplify: parameter `max_depth`: 0: must be in 1..=30"),
+        "vstree_simplify: parameter `max_depth`: 0: must be from 1 to 30"),
     ROW(simplify_max_depth_31, INVALID_PARAMETER,
-        "vstree_simplify: parameter `max_depth`: 31: must be in 1..=30"),
+        "vstree_simplify: parameter `max_depth`: 31: must be from 1 to 30"),
     ROW(simplify_max_depth_huge, INVALID_PARAMETER,
-        "vstree_simplify: parameter `max_depth`: 4294967295: must be in 1..=30"),
+        "vstree_simplify: parameter `max_depth`: 4294967295: must be from 1 to 30"),
     ROW(simplify_threads_1025, INVALID_PARAMETER,
         "vstree_simplify: parameter `threads`: 1025: must be 0 (all cores) to 1024"),
     ROW(simplify_threads_huge, INVALID_PARAMETER,
@@ -1245,7 +1359,7 @@ static const bad_case g_cases[] = {
     ROW(tree_d_d_neg, INVALID_PARAMETER,
         "vstree_tree_build: parameter `d_d`: -1: must be in [0, 1]"),
     ROW(tree_max_depth_zero, INVALID_PARAMETER,
-        "vstree_tree_build: parameter `max_depth`: 0: must be in 1..=30"),
+        "vstree_tree_build: parameter `max_depth`: 0: must be from 1 to 30"),
     ROW(tree_threads_1025, INVALID_PARAMETER,
         "vstree_tree_build: parameter `threads`: 1025: must be 0 (all cores) to 1024"),
     ROW(tree_min_cell_one, INVALID_PARAMETER,
@@ -1287,8 +1401,8 @@ static const bad_case g_cases[] = {
     ROW(reconstruct_nine_points, INVALID_INPUT,
         "vstree_reconstruct: invalid input: 9 points: at least 10 are needed"),
     ROW(reconstruct_collinear, INVALID_INPUT,
-        "vstree_reconstruct: invalid input: all 12 points lie on one line: no plane to estimate "
-        "normals from"),
+        "vstree_reconstruct: invalid input: all 12 points lie on one line: no surface passes "
+        "through them"),
     ROW(reconstruct_take_mesh_null, NULL_POINTER,
         "vstree_reconstruct_result_take_mesh: `result` is NULL"),
     ROW(reconstruct_size_zero, INVALID_ARGUMENT,
@@ -1326,13 +1440,13 @@ static const bad_case g_cases[] = {
     ROW(reconstruct_d_d_inf, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `d_d`: inf: must be in [0, 1]"),
     ROW(reconstruct_max_depth_zero, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `max_depth`: 0: must be in 1..=30"),
+        "vstree_reconstruct: parameter `max_depth`: 0: must be from 1 to 30"),
     ROW(reconstruct_max_depth_31, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `max_depth`: 31: must be in 1..=30"),
+        "vstree_reconstruct: parameter `max_depth`: 31: must be from 1 to 30"),
     ROW(reconstruct_max_levels_13, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `max_levels`: 13: must be in 0..=12"),
+        "vstree_reconstruct: parameter `max_levels`: 13: must be from 0 to 12"),
     ROW(reconstruct_max_levels_huge, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `max_levels`: 4294967295: must be in 0..=12"),
+        "vstree_reconstruct: parameter `max_levels`: 4294967295: must be from 0 to 12"),
     ROW(reconstruct_min_cell_neg, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `min_cell_size`: -0.0000001: must be in [0, 1)"),
     ROW(reconstruct_min_cell_one, INVALID_PARAMETER,
@@ -1352,13 +1466,13 @@ static const bad_case g_cases[] = {
     ROW(reconstruct_displaced_nan, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `min_displaced`: NaN: must be in [0, 1]"),
     ROW(reconstruct_max_triangles_zero, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `max_triangles`: 0: must be in 1..=2^32-1"),
+        "vstree_reconstruct: parameter `max_triangles`: 0: must be from 1 to 4294967295"),
     ROW(reconstruct_grid_3, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `max_grid_depth`: 3: must be in 4..=20"),
+        "vstree_reconstruct: parameter `max_grid_depth`: 3: must be from 4 to 20"),
     ROW(reconstruct_grid_21, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `max_grid_depth`: 21: must be in 4..=20"),
+        "vstree_reconstruct: parameter `max_grid_depth`: 21: must be from 4 to 20"),
     ROW(reconstruct_grid_zero, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `max_grid_depth`: 0: must be in 4..=20"),
+        "vstree_reconstruct: parameter `max_grid_depth`: 0: must be from 4 to 20"),
     ROW(reconstruct_trim_neg, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `trim`: -1: must be >= 0"),
     ROW(reconstruct_trim_nan, INVALID_PARAMETER,
@@ -1366,9 +1480,9 @@ static const bad_case g_cases[] = {
     ROW(reconstruct_trim_inf, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `trim`: inf: must be >= 0"),
     ROW(reconstruct_neighbours_2, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `neighbours`: 2 is not in 3..=256"),
+        "vstree_reconstruct: parameter `neighbours`: 2: must be from 3 to 256"),
     ROW(reconstruct_neighbours_257, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `neighbours`: 257 is not in 3..=256"),
+        "vstree_reconstruct: parameter `neighbours`: 257: must be from 3 to 256"),
     ROW(reconstruct_reorient_2, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `reorient_given`: 2: must be 0 or 1"),
     ROW(reconstruct_threads_1025, INVALID_PARAMETER,
@@ -1379,8 +1493,8 @@ static const bad_case g_cases[] = {
     ROW(normals_two_points, INVALID_INPUT,
         "vstree_estimate_normals: invalid input: 2 points: normals need at least 3"),
     ROW(normals_collinear, INVALID_INPUT,
-        "vstree_estimate_normals: invalid input: all 12 points lie on one line: no plane to "
-        "estimate normals from"),
+        "vstree_estimate_normals: invalid input: all 12 points lie on one line: no surface passes "
+        "through them"),
     ROW(normals_report_size_zero, INVALID_ARGUMENT,
         "vstree_estimate_normals: `out_report->struct_size`: 0: set it to "
         "sizeof(vstree_normals_report) before the call"),
@@ -1408,13 +1522,13 @@ static const bad_case g_cases[] = {
         "(VSTREE_ORIENTATION_UNORIENTED), 1 (VSTREE_ORIENTATION_PROPAGATE), 2 "
         "(VSTREE_ORIENTATION_PROPAGATE_MAJORITY), 3 (VSTREE_ORIENTATION_PROPAGATE_OUTWARD)"),
     ROW(normals_neighbours_zero, INVALID_PARAMETER,
-        "vstree_estimate_normals: parameter `neighbours`: 0 is not in 3..=256"),
+        "vstree_estimate_normals: parameter `neighbours`: 0: must be from 3 to 256"),
     ROW(normals_neighbours_2, INVALID_PARAMETER,
-        "vstree_estimate_normals: parameter `neighbours`: 2 is not in 3..=256"),
+        "vstree_estimate_normals: parameter `neighbours`: 2: must be from 3 to 256"),
     ROW(normals_neighbours_257, INVALID_PARAMETER,
-        "vstree_estimate_normals: parameter `neighbours`: 257 is not in 3..=256"),
+        "vstree_estimate_normals: parameter `neighbours`: 257: must be from 3 to 256"),
     ROW(normals_neighbours_huge, INVALID_PARAMETER,
-        "vstree_estimate_normals: parameter `neighbours`: 4294967295 is not in 3..=256"),
+        "vstree_estimate_normals: parameter `neighbours`: 4294967295: must be from 3 to 256"),
     ROW(normals_reorient_2, INVALID_PARAMETER,
         "vstree_estimate_normals: parameter `reorient_given`: 2: must be 0 or 1"),
     ROW(normals_threads_1025, INVALID_PARAMETER,

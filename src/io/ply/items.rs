@@ -146,7 +146,7 @@ pub(crate) fn error(path: &Path, line: Option<usize>, element: &Element, item: u
         (Fail::End, line) => Error::parse(
             path,
             line.map_or(subject.clone(), |n| format!("line {n}")),
-            format!("file ends in {subject} of {}", element.count),
+            format!("file ends after {item} of the {} `{}` elements", element.count, element.name),
         ),
         (Fail::Bad(message), Some(n)) => Error::parse(path, format!("line {n}"), format!("{subject}: {message}")),
         (Fail::Bad(message), None) => Error::parse(path, subject, message),
