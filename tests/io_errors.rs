@@ -136,13 +136,13 @@ fn absurd_counts_in_tiny_files_fail_fast() {
         property float x\nproperty float y\nproperty float z\nend_header\n"
         .to_vec();
     huge.extend_from_slice(&[0; 100]);
-    expect_at(ply(&huge), "vertex 8", "of 2147483648");
+    expect_at(ply(&huge), "vertex 8", "of the 2147483648 `vertex` elements");
     let ascii = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
         property float z\nelement face 18446744073709551615\nproperty list uint uint vertex_indices\n\
         end_header\n0 0 0\n0 0 0\n0 0 0\n4294967295 0 1 2\n";
     expect_at(ply(ascii), "line 13", "face 0: expected 4294967296 values, found 4");
     let (_, message) = off("OFF\n4000000000 4000000000 0\n0 0 0\n");
-    assert!(message.contains("file ends after 1 of the 4000000000 `vertex` elements"), "{message}");
+    assert!(message.contains("file ends after 1 of the 4000000000 vertices"), "{message}");
     // Elements without properties occupy no bytes, whatever their count.
     let empty = b"ply\nformat binary_big_endian 1.0\nelement vertex 0\nproperty float x\n\
         property float y\nproperty float z\nelement nothing 1000000000000000000\nend_header\n";
