@@ -157,3 +157,58 @@ fn a_cloud_without_normals_gets_them_estimated() {
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// The output folder is checked before the input is even read: a run that could not be saved
+/// fails at once instead of after all its work.
+#[test]
+fn an_unwritable_output_fails_before_the_work() {
+    let dir = temp_dir("output-first");
+    let input = dir.join("broken.off");
+    std::fs::write(&input, "OFF\n3 1 0\n0 0 0\n").unwrap();
+    let output = dir.join("missing-folder/out.ply");
+    for command in ["simplify", "reconstruct"] {
+        let run = vstree(&[command, input.to_str().unwrap(), output.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(stderr, format!("vstree: error: {}: No such file or directory (os error 2)\n", output.display()));
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// SIGINT, SIGTERM or SIGHUP while a run is under way leave no hidden temporary output behind,
+/// and the process still ends by the signal (so shells see it as interrupted).
+#[cfg(unix)]
+#[test]
+fn an_interrupted_run_leaves_no_temporary_file() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::time::{Duration, Instant};
+    let dir = temp_dir("signals");
+    let input = dir.join("cloud.ply");
+    // Large enough that reconstruction runs for a while after the output is reserved.
+    io::write(&input, &shapes::sample_surface(&shapes::genus_n_pretzel(2), 300_000, 5)).unwrap();
+    let output = dir.join("out.ply");
+    for signal in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_vstree"))
+            .args(["reconstruct", input.to_str().unwrap(), output.to_str().unwrap(), "-q"])
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        let temporary = || {
+            std::fs::read_dir(&dir)
+                .unwrap()
+                .any(|e| e.unwrap().file_name().to_string_lossy().starts_with(".out.ply.tmp-"))
+        };
+        while !temporary() {
+            assert!(start.elapsed() < Duration::from_secs(20), "no temporary output appeared");
+            assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be interrupted");
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        // SAFETY: the child is alive (not yet waited for).
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
+        let status = child.wait().unwrap();
+        assert_eq!(status.signal(), Some(signal), "{status:?}");
+        let names: Vec<String> =
+            std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, vec!["cloud.ply"], "signal {signal}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
