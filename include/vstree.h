@@ -75,7 +75,7 @@
 /**
  * Patch version (semver).
  */
-#define VSTREE_VERSION_PATCH 1
+#define VSTREE_VERSION_PATCH 2
 
 /**
  * The ABI version: the number in the shared library's SONAME (`libvstree.so.0`). It changes
@@ -160,7 +160,8 @@ enum vstree_status
    */
   VSTREE_STATUS_INVALID_PARAMETER = 3,
   /**
-   * The geometry cannot be processed: no vertices, a NaN or infinite coordinate, a triangle
+   * The geometry cannot be processed: no vertices, a NaN, infinite or too large (beyond 1e18)
+   * coordinate, a triangle
    * index out of range, a point cloud without normals, only degenerate triangles. The
    * message names the first offending element.
    */
@@ -1064,8 +1065,9 @@ size_t vstree_last_error_copy(char *buffer, size_t capacity);
  * them and may free them when the call returns). The new handle is written to `*out_mesh`
  * and belongs to the caller, who frees it with vstree_mesh_free().
  *
- * - `positions`: 3 × `vertex_count` floats, x y z per vertex. `vertex_count` must be at
- *   least 1 and at most 2^32 - 1.
+ * - `positions`: 3 × `vertex_count` floats, x y z per vertex, finite and at most 1e18 in
+ *   magnitude (squares of coordinate differences must fit a float). `vertex_count` must be
+ *   at least 1 and at most 2^32 - 1.
  * - `normals`: NULL, or 3 × `vertex_count` floats, one normal per vertex (any length but
  *   zero; they are normalised where used). Point clouds need normals to be simplified.
  * - `triangles`: 3 × `triangle_count` vertex indices (counter-clockwise seen from outside;
@@ -1075,7 +1077,7 @@ size_t vstree_last_error_copy(char *buffer, size_t capacity);
  * Fails with VSTREE_STATUS_NULL_POINTER (a needed array or `out_mesh` is NULL),
  * VSTREE_STATUS_TOO_LARGE (a count beyond the limits), VSTREE_STATUS_INVALID_ARGUMENT (an
  * array misaligned for its type), VSTREE_STATUS_INVALID_INPUT (no vertex, a NaN or infinite
- * coordinate or normal, an index out of range; the message names the first one) or
+ * coordinate or normal, a coordinate beyond 1e18, an index out of range; the message names the first one) or
  * VSTREE_STATUS_OUT_OF_MEMORY. Thread-safe.
  */
 vstree_status vstree_mesh_create(const float *positions,
@@ -1156,6 +1158,19 @@ int32_t vstree_mesh_has_normals(const struct vstree_mesh *mesh);
 vstree_status vstree_mesh_copy_positions(const struct vstree_mesh *mesh,
                                          float *out,
                                          size_t capacity);
+
+/**
+ * Copies the vertex positions, in double precision, into the caller's buffer `out` of
+ * `capacity` doubles (at least 3 × vertex count). A model read from a file far from the
+ * origin for its size (georeferenced coordinates, say) is stored relative to an origin of its
+ * own; these are its exact absolute positions, where vstree_mesh_copy_positions() rounds them
+ * to float. The caller owns `out`. Since 0.1.2.
+ *
+ * Fails like vstree_mesh_copy_positions(). Thread-safe.
+ */
+vstree_status vstree_mesh_copy_positions_f64(const struct vstree_mesh *mesh,
+                                             double *out,
+                                             size_t capacity);
 
 /**
  * Copies the per-vertex normals into the caller's buffer `out` of `capacity` floats, which

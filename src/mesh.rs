@@ -2,17 +2,22 @@
 //! with no triangles.
 
 use crate::error::{Error, Result};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 /// An indexed triangle mesh, or a point cloud when `triangles` is empty.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
-    /// Vertex positions.
+    /// Vertex positions, relative to `origin`.
     pub positions: Vec<Vec3>,
     /// Per-vertex normals, when the source has them (same length as `positions`).
     pub normals: Option<Vec<Vec3>>,
     /// Triangles as counter-clockwise vertex index triples (the input's winding is kept).
     pub triangles: Vec<[u32; 3]>,
+    /// Where `positions` are measured from: a vertex is at `origin + position`. Zero unless the
+    /// mesh was read from a file far from the origin for its size (see [`crate::io`]), where
+    /// f32 coordinates would lose its detail. Every stage works on the relative positions and
+    /// gives its result the input's origin; the writers add it back in f64.
+    pub origin: DVec3,
 }
 
 /// Largest coordinate magnitude accepted. The geometry is `f32`: squared lengths of
@@ -65,9 +70,19 @@ impl Aabb {
 }
 
 impl Mesh {
+    /// A mesh at the origin (see [`Mesh::origin`]).
+    pub fn new(positions: Vec<Vec3>, normals: Option<Vec<Vec3>>, triangles: Vec<[u32; 3]>) -> Mesh {
+        Mesh { positions, normals, triangles, origin: DVec3::ZERO }
+    }
+
     /// A point cloud (no triangles), with or without normals.
     pub fn from_points(positions: Vec<Vec3>, normals: Option<Vec<Vec3>>) -> Mesh {
-        Mesh { positions, normals, triangles: Vec::new() }
+        Mesh::new(positions, normals, Vec::new())
+    }
+
+    /// The absolute position of vertex `i`, in f64.
+    pub fn absolute(&self, i: usize) -> DVec3 {
+        self.origin + self.positions[i].as_dvec3()
     }
 
     pub fn is_point_cloud(&self) -> bool {

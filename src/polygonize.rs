@@ -369,7 +369,7 @@ pub(crate) fn track_surface(
     if positions.len() >= u32::MAX as usize {
         return Err(Error::TooLarge("more than 2^32 vertices".into()));
     }
-    Ok(Mesh { positions, normals: None, triangles })
+    Ok(Mesh::new(positions, None, triangles))
 }
 
 #[cfg(test)]

@@ -125,11 +125,11 @@ mod tests {
     use super::*;
 
     fn quad() -> Mesh {
-        Mesh {
-            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y, Vec3::splat(9.0)],
-            normals: None,
-            triangles: vec![[0, 1, 2], [0, 2, 3], [0, 0, 1]],
-        }
+        Mesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y, Vec3::splat(9.0)],
+            None,
+            vec![[0, 1, 2], [0, 2, 3], [0, 0, 1]],
+        )
     }
 
     #[test]

@@ -85,7 +85,7 @@ pub fn icosphere(radius: f32, subdivisions: u32) -> Mesh {
         triangles = finer;
     }
     let radius = radius.abs();
-    Mesh { positions: directions.iter().map(|&d| d * radius).collect(), normals: Some(directions), triangles }
+    Mesh::new(directions.iter().map(|&d| d * radius).collect(), Some(directions), triangles)
 }
 
 /// A torus around the z axis, centred at the origin: the tube of radius `minor` around the
@@ -117,7 +117,7 @@ pub fn torus(major: f32, minor: f32, major_segments: u32, minor_segments: u32) -
             triangles.extend([[a, b, c], [a, c, d]]);
         }
     }
-    Mesh { positions, normals: Some(normals), triangles }
+    Mesh::new(positions, Some(normals), triangles)
 }
 
 /// The radius of [`bumpy_sphere`] in the unit direction `direction`:
@@ -380,7 +380,7 @@ pub fn implicit_mesh(f: impl Fn(Vec3) -> f32 + Sync, min: Vec3, max: Vec3, resol
             g.normalize_or_zero()
         })
         .collect();
-    let mut mesh = Mesh { positions, normals: None, triangles };
+    let mut mesh = Mesh::new(positions, None, triangles);
     if normals.contains(&Vec3::ZERO) {
         let fallback = mesh.area_weighted_normals();
         for (n, alt) in normals.iter_mut().zip(fallback) {

@@ -142,12 +142,13 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
         cluster_mesh(mesh, params, &threads, progress)?;
     let t = Instant::now();
     let stats = tree.stats();
-    let out = if mesh.is_point_cloud() {
+    let mut out = if mesh.is_point_cloud() {
         Mesh::from_points(clusters.representatives, Some(clusters.normals))
     } else {
         let labels = vertex_labels(mesh, &samples, &clusters, params.sampling, &tree);
         collapse(mesh, &labels, &clusters.representatives, &threads)?
     };
+    out.origin = mesh.origin;
     if !mesh.triangles.is_empty() && out.triangles.is_empty() {
         return Err(Error::param(
             "error",
@@ -267,5 +268,5 @@ fn collapse(mesh: &Mesh, labels: &[u32], representatives: &[Vec3], threads: &Thr
     if positions.len() > u32::MAX as usize {
         return Err(Error::TooLarge("output vertices".into()));
     }
-    Ok(Mesh { positions, normals: None, triangles })
+    Ok(Mesh::new(positions, None, triangles))
 }

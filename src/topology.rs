@@ -363,11 +363,7 @@ mod tests {
 
     /// A unit tetrahedron with outward winding.
     fn tetrahedron() -> Mesh {
-        Mesh {
-            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
-            normals: None,
-            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        }
+        Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z], None, vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     }
 
     #[test]

@@ -35,7 +35,7 @@ fn one_two_three_samples_give_trivial_results() {
         assert!(!out.positions.is_empty() && out.positions.len() <= n);
         assert_eq!(stats.tree.samples, n);
     }
-    let triangle = Mesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y], normals: None, triangles: vec![[0, 1, 2]] };
+    let triangle = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], None, vec![[0, 1, 2]]);
     // Flat: one cluster, no triangle left, which is an error rather than an empty mesh.
     let m = message(simplify_default(&triangle));
     assert!(m.contains("every triangle collapsed (1 cluster for the whole model)"), "{m}");
@@ -107,22 +107,21 @@ fn zero_normals_in_a_cloud_are_refused() {
 
 #[test]
 fn out_of_range_indices_are_refused() {
-    let mesh = Mesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y], normals: None, triangles: vec![[0, 1, 7]] };
+    let mesh = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], None, vec![[0, 1, 7]]);
     let m = message(simplify_default(&mesh));
     assert!(m.contains("triangle 0") && m.contains('7'), "{m}");
 }
 
 #[test]
 fn degenerate_triangles_are_ignored() {
-    let mesh = Mesh {
-        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(2.0, 0.0, 0.0)],
-        normals: None,
-        triangles: vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
-    };
+    let mesh = Mesh::new(
+        vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(2.0, 0.0, 0.0)],
+        None,
+        vec![[0, 1, 2], [0, 0, 1], [0, 1, 3]],
+    );
     // Flat, so every triangle collapses; the degenerate one is no cause of failure.
     assert!(message(simplify_default(&mesh)).contains("every triangle collapsed"));
-    let all_degenerate =
-        Mesh { positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y], normals: None, triangles: vec![[0, 0, 1]] };
+    let all_degenerate = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], None, vec![[0, 0, 1]]);
     assert!(message(simplify_default(&all_degenerate)).contains("degenerate"));
 }
 

@@ -40,7 +40,7 @@ fn grid(n: u32) -> Mesh {
             triangles.push([i + 1, i + n + 1, i + n]);
         }
     }
-    Mesh { positions, normals: None, triangles }
+    Mesh::new(positions, None, triangles)
 }
 
 #[test]

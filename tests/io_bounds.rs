@@ -37,6 +37,8 @@ struct Run {
 }
 
 /// Runs `vstree args`, killing it after `limit` (a hang guard, far above what any case needs).
+/// The child is reaped by `wait4`, which also gives its peak memory, not by `Child::wait`.
+#[allow(clippy::zombie_processes)]
 fn run(args: &[&Path], limit: Duration) -> Run {
     let start = Instant::now();
     let mut child = Command::new(env!("CARGO_BIN_EXE_vstree"))

@@ -35,11 +35,11 @@ fn pyramid(with_normals: bool) -> Mesh {
         Vec3::new(0.5, 0.5, std::f32::consts::PI),
     ];
     let normals = positions.iter().map(|p| p.normalize()).collect();
-    Mesh {
+    Mesh::new(
         positions,
-        normals: with_normals.then_some(normals),
-        triangles: vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1], [1, 4, 3], [1, 3, 2]],
-    }
+        with_normals.then_some(normals),
+        vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1], [1, 4, 3], [1, 3, 2]],
+    )
 }
 
 fn close(a: &[Vec3], b: &[Vec3]) -> bool {

@@ -167,19 +167,15 @@ fn sampling_a_sphere() {
     assert_ne!(sample_surface(&sphere, 10, 8).positions, cloud.positions[..10]);
     assert_eq!(sample_surface(&sphere, 10, 7).positions, cloud.positions[..10]);
     assert!(sample_surface(&Mesh::default(), 10, 1).positions.is_empty());
-    let flat = Mesh {
-        positions: vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
-        normals: None,
-        triangles: vec![[0, 1, 2], [0, 1, 7]],
-    };
+    let flat = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0], None, vec![[0, 1, 2], [0, 1, 7]]);
     assert!(sample_surface(&flat, 10, 1).positions.is_empty());
 }
 
 #[test]
 fn sampling_is_uniform_across_triangles_of_different_size() {
     // Two triangles, areas 1 and 3: expect a quarter and three quarters of the points.
-    let m = Mesh {
-        positions: vec![
+    let m = Mesh::new(
+        vec![
             Vec3::ZERO,
             Vec3::X * 2.0,
             Vec3::Y,
@@ -187,9 +183,9 @@ fn sampling_is_uniform_across_triangles_of_different_size() {
             Vec3::new(16.0, 0.0, 0.0),
             Vec3::new(10.0, 1.0, 0.0),
         ],
-        normals: None,
-        triangles: vec![[0, 1, 2], [3, 4, 5]],
-    };
+        None,
+        vec![[0, 1, 2], [3, 4, 5]],
+    );
     let cloud = sample_surface(&m, 40_000, 3);
     let small = cloud.positions.iter().filter(|p| p.x < 5.0).count();
     assert!((small as f32 / 40_000.0 - 0.25).abs() < 0.01, "{small}");
@@ -327,7 +323,7 @@ fn read_off(path: &Path) -> Mesh {
             triangles.push([ids[0], ids[i], ids[i + 1]]);
         }
     }
-    Mesh { positions, normals: None, triangles }
+    Mesh::new(positions, None, triangles)
 }
 
 #[test]

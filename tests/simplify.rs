@@ -125,11 +125,11 @@ fn same_output_with_one_or_two_threads() {
 #[test]
 fn non_manifold_input_is_fine() {
     // Three triangles on one edge, plus a repeated triangle with the opposite winding.
-    let mesh = Mesh {
-        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, -Vec3::Y],
-        normals: None,
-        triangles: vec![[0, 1, 2], [0, 1, 3], [1, 0, 4], [2, 1, 0]],
-    };
+    let mesh = Mesh::new(
+        vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z, -Vec3::Y],
+        None,
+        vec![[0, 1, 2], [0, 1, 3], [1, 0, 4], [2, 1, 0]],
+    );
     // (All these faces' planes contain the x axis, so under L2 one cluster would represent
     // them exactly; one sample per cluster keeps every vertex.)
     let params = SimplifyParams {

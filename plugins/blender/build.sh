@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the VS-Tree Blender extension zip:
-#   target/blender/dist/vstree-0.1.1-linux_x64.zip
+#   target/blender/dist/vstree-0.1.2-linux_x64.zip
 # Stages plugins/blender/vstree_blender + bindings/python/vstree + libvstree.so under
 # target/blender/stage/vstree, then runs Blender's own blender_ext.py build.
 #
@@ -34,5 +34,5 @@ cp bindings/python/vstree/*.py "$stage/vstree/"
 cp "$lib" "$stage/vstree/libvstree.so"
 
 "$python" "$ext_py" build --source-dir "$stage" --output-dir "$dist" --split-platforms
-"$python" "$ext_py" validate "$dist"/vstree-0.1.1-linux_x64.zip
-echo "built $dist/vstree-0.1.1-linux_x64.zip"
+"$python" "$ext_py" validate "$dist"/vstree-0.1.2-linux_x64.zip
+echo "built $dist/vstree-0.1.2-linux_x64.zip"

@@ -98,11 +98,11 @@ pub unsafe extern "C" fn vstree_mesh_create(
             false => Some(unsafe { input(normals, floats, "normals") }?),
         };
         let triangles = unsafe { input(triangles, indices, "triangles") }?;
-        let mesh = Mesh {
-            positions: triples::<f32, Vec3>(positions, "positions")?,
-            normals: normals.map(|n| triples::<f32, Vec3>(n, "normals")).transpose()?,
-            triangles: triples::<u32, [u32; 3]>(triangles, "triangles")?,
-        };
+        let mesh = Mesh::new(
+            triples::<f32, Vec3>(positions, "positions")?,
+            normals.map(|n| triples::<f32, Vec3>(n, "normals")).transpose()?,
+            triples::<u32, [u32; 3]>(triangles, "triangles")?,
+        );
         mesh.check()?;
         unsafe { write_out(out_mesh, into_handle(mesh)) };
         Ok(())
@@ -263,7 +263,31 @@ pub unsafe extern "C" fn vstree_mesh_copy_positions(
 ) -> vstree_status {
     guard("vstree_mesh_copy_positions", || {
         let mesh = unsafe { mesh_ref(mesh, "mesh") }?;
-        unsafe { copy_out(flat(&mesh.positions), out, capacity, "out") }
+        if mesh.origin == glam::DVec3::ZERO {
+            return unsafe { copy_out(flat(&mesh.positions), out, capacity, "out") };
+        }
+        let absolute: Vec<Vec3> = (0..mesh.positions.len()).map(|i| mesh.absolute(i).as_vec3()).collect();
+        unsafe { copy_out(flat(&absolute), out, capacity, "out") }
+    })
+}
+
+/// Copies the vertex positions, in double precision, into the caller's buffer `out` of
+/// `capacity` doubles (at least 3 × vertex count). A model read from a file far from the
+/// origin for its size (georeferenced coordinates, say) is stored relative to an origin of its
+/// own; these are its exact absolute positions, where vstree_mesh_copy_positions() rounds them
+/// to float. The caller owns `out`. Since 0.1.2.
+///
+/// Fails like vstree_mesh_copy_positions(). Thread-safe.
+#[no_mangle]
+pub unsafe extern "C" fn vstree_mesh_copy_positions_f64(
+    mesh: *const vstree_mesh,
+    out: *mut f64,
+    capacity: usize,
+) -> vstree_status {
+    guard("vstree_mesh_copy_positions_f64", || {
+        let mesh = unsafe { mesh_ref(mesh, "mesh") }?;
+        let absolute: Vec<f64> = (0..mesh.positions.len()).flat_map(|i| mesh.absolute(i).to_array()).collect();
+        unsafe { copy_out(&absolute, out, capacity, "out") }
     })
 }
 

@@ -251,6 +251,7 @@ pub unsafe extern "C" fn vstree_estimate_normals(
             positions: copy_of(&mesh.positions, "positions")?,
             normals: mesh.normals.as_ref().map(|n| copy_of(n, "normals")).transpose()?,
             triangles: copy_of(&mesh.triangles, "triangles")?,
+            origin: mesh.origin,
         };
         let r = with_progress(progress, user_data, |p| normals::ensure_normals(&mut copy, &params, p))?;
         if room > 0 {

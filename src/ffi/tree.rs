@@ -232,6 +232,8 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
         NodeKind::Volume => VSTREE_NO_INDEX,
         _ => frame_to_t.get(tree.nodes[i].frame as usize).copied().unwrap_or(VSTREE_NO_INDEX),
     };
+    // The tree is built on positions relative to the mesh's origin; callers see absolute ones.
+    let absolute = |p: glam::Vec3| (mesh.origin + p.as_dvec3()).as_vec3().to_array();
     let mut node_cluster = vec![VSTREE_NO_INDEX; tree.nodes.len()];
     for (k, &leaf) in clusters.leaves.iter().enumerate() {
         node_cluster[leaf as usize] = k as u32;
@@ -249,7 +251,7 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
             sample_count: n.count,
             t_node: t_of(i),
             cluster: node_cluster[i],
-            center: n.center.to_array(),
+            center: absolute(n.center),
             half: n.half,
         })
         .collect();
@@ -271,9 +273,9 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
                 depth: n.depth.into(),
                 sample_count: n.count,
                 cluster_count,
-                cube_center: n.center.to_array(),
+                cube_center: absolute(n.center),
                 cube_half: n.half,
-                origin: f.origin.to_array(),
+                origin: absolute(f.origin),
                 normal: f.normal.to_array(),
                 u: f.u.to_array(),
                 v: f.v.to_array(),

@@ -14,7 +14,7 @@ mod scan;
 use crate::error::{Error, Result};
 use crate::io::{assemble, text};
 use crate::mesh::Mesh;
-use glam::Vec3;
+use glam::DVec3;
 use scan::Data;
 use std::io::{self, Write};
 use std::panic::{self, AssertUnwindSafe};
@@ -77,17 +77,18 @@ fn non_finite(source: &str, path: &Path, data: Data, fallback: String) -> Error 
 
 /// Concatenates tobj's models, offsetting each one's indices.
 fn merge(models: &[tobj::Model], source: &str, path: &Path) -> Result<Mesh> {
+    let mut positions = Vec::new();
     let mut mesh = Mesh { normals: Some(Vec::new()), ..Mesh::default() };
     for model in models {
         let m = &model.mesh;
-        let offset = u32::try_from(mesh.positions.len())
+        let offset = u32::try_from(positions.len())
             .map_err(|_| Error::TooLarge(format!("{}: too many vertices", path.display())))?;
         for p in m.positions.chunks_exact(3) {
-            let p = Vec3::new(p[0], p[1], p[2]);
-            let vertex = mesh.positions.len();
+            let p = DVec3::new(p[0], p[1], p[2]);
+            let vertex = positions.len();
             let p = assemble::finite_position(p)
                 .map_err(|e| non_finite(source, path, Data::Position, format!("vertex {vertex} {e}")))?;
-            mesh.positions.push(p);
+            positions.push(p);
         }
         for t in m.indices.chunks_exact(3) {
             let shift = |i: u32| {
@@ -100,7 +101,7 @@ fn merge(models: &[tobj::Model], source: &str, path: &Path) -> Result<Mesh> {
             Some(normals) if per_vertex => {
                 for n in m.normals.chunks_exact(3) {
                     let vertex = normals.len(); // normals are per vertex, so this is its index
-                    let n = assemble::finite_normal(Vec3::new(n[0], n[1], n[2]))
+                    let n = assemble::finite_normal(DVec3::new(n[0], n[1], n[2]).as_vec3())
                         .map_err(|e| non_finite(source, path, Data::Normal, format!("vertex {vertex}: {e}")))?;
                     normals.push(n);
                 }
@@ -108,7 +109,7 @@ fn merge(models: &[tobj::Model], source: &str, path: &Path) -> Result<Mesh> {
             _ => mesh.normals = None,
         }
     }
-    Ok(mesh)
+    Ok(assemble::mesh(positions, mesh.normals, mesh.triangles))
 }
 
 /// A file without faces: every `v` line is a point; `vn` lines are its normals when there is
@@ -126,35 +127,36 @@ fn points(source: &str, path: &Path) -> Result<Mesh> {
             _ => continue,
         };
         let at = |m: String| Error::parse(path, format!("line {n}"), m);
-        let mut xyz = [0.0f32; 3];
+        let mut xyz = [0.0f64; 3];
         for c in &mut xyz {
             let word = words.next().ok_or_else(|| at("expected 3 numbers".into()))?;
             *c = text::number(word).map_err(at)?;
         }
         if is_position {
             let vertex = positions.len();
-            let p = assemble::finite_position(Vec3::from(xyz)).map_err(|m| at(format!("vertex {vertex} {m}")))?;
+            let p = assemble::finite_position(DVec3::from(xyz)).map_err(|m| at(format!("vertex {vertex} {m}")))?;
             positions.push(p);
         } else {
             let normal = normals.len();
-            if let (None, Err(m)) = (&bad_normal, assemble::finite_normal(Vec3::from(xyz))) {
+            let xyz = DVec3::from(xyz).as_vec3();
+            if let (None, Err(m)) = (&bad_normal, assemble::finite_normal(xyz)) {
                 bad_normal = Some(at(format!("normal {normal} {m}")));
             }
-            normals.push(Vec3::from(xyz));
+            normals.push(xyz);
         }
     }
     let has_normals = !normals.is_empty() && normals.len() == positions.len();
     if let (true, Some(error)) = (has_normals, bad_normal) {
         return Err(error);
     }
-    Ok(Mesh::from_points(positions, has_normals.then_some(normals)))
+    Ok(assemble::mesh(positions, has_normals.then_some(normals), Vec::new()))
 }
 
 /// Writes `mesh` as OBJ with 1-based indices; with normals, faces are `f a//a b//b c//c`.
 pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh) -> io::Result<()> {
     writeln!(out, "# written by vstree")?;
-    for p in &mesh.positions {
-        writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+    for i in 0..mesh.positions.len() {
+        writeln!(out, "v {}", text::Position(mesh, i))?;
     }
     if let Some(normals) = &mesh.normals {
         for n in normals {
@@ -175,6 +177,7 @@ pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     fn parse_str(s: &str) -> Result<Mesh> {
         parse(s.as_bytes(), Path::new("t.obj"))

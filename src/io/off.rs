@@ -7,7 +7,7 @@
 use crate::error::{Error, Result};
 use crate::io::{assemble, text};
 use crate::mesh::Mesh;
-use glam::Vec3;
+use glam::DVec3;
 use std::borrow::Cow;
 use std::io::{self, Write};
 use std::path::Path;
@@ -46,10 +46,10 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     for i in 0..vertex_count {
         let (n, line) = next(&|| format!("file ends after {i} of the {vertex_count} vertices"))?;
         let values = numbers(&line, columns).map_err(|m| at(n, format!("vertex {i}: {m}")))?;
-        let p = Vec3::new(values[0], values[1], values[2]);
+        let p = DVec3::new(values[0], values[1], values[2]);
         positions.push(assemble::finite_position(p).map_err(|m| at(n, format!("vertex {i}: {m}")))?);
         if let Some(normals) = &mut normals {
-            let normal = assemble::finite_normal(Vec3::new(values[3], values[4], values[5]));
+            let normal = assemble::finite_normal(DVec3::new(values[3], values[4], values[5]).as_vec3());
             normals.push(normal.map_err(|m| at(n, format!("vertex {i}: {m}")))?);
         }
     }
@@ -62,7 +62,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
             .and_then(|()| assemble::push_fan(&polygon, &mut triangles))
             .map_err(|m| at(n, format!("face {i}: {m}")))?;
     }
-    Ok(Mesh { positions, normals, triangles })
+    Ok(assemble::mesh(positions, normals, triangles))
 }
 
 /// Checks the start of a file before it is read whole: the first content line, when `prefix`
@@ -107,8 +107,8 @@ fn parse_counts(words: &[String]) -> Result<(usize, usize), String> {
 }
 
 /// The first `columns` numbers of a line (the rest, e.g. a color, is ignored).
-fn numbers(line: &str, columns: usize) -> Result<Vec<f32>, String> {
-    let values = line.split_whitespace().take(columns).map(text::number).collect::<Result<Vec<f32>, _>>()?;
+fn numbers(line: &str, columns: usize) -> Result<Vec<f64>, String> {
+    let values = line.split_whitespace().take(columns).map(text::number).collect::<Result<Vec<f64>, _>>()?;
     if values.len() < columns {
         return Err(format!("expected {columns} numbers, found {}", values.len()));
     }
@@ -130,8 +130,8 @@ fn read_face(line: &str, vertex_count: usize, polygon: &mut Vec<u32>) -> Result<
 /// Writes `mesh` as plain OFF (normals are not part of plain OFF and are dropped).
 pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh) -> io::Result<()> {
     writeln!(out, "OFF\n{} {} 0", mesh.positions.len(), mesh.triangles.len())?;
-    for p in &mesh.positions {
-        writeln!(out, "{} {} {}", p.x, p.y, p.z)?;
+    for i in 0..mesh.positions.len() {
+        writeln!(out, "{}", text::Position(mesh, i))?;
     }
     for [a, b, c] in &mesh.triangles {
         writeln!(out, "3 {a} {b} {c}")?;
@@ -142,6 +142,7 @@ pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     fn parse_str(s: &str) -> Result<Mesh> {
         parse(s.as_bytes(), Path::new("t.off"))

@@ -1,7 +1,10 @@
 //! Small helpers shared by the line-oriented text formats (OFF, XYZ, ASCII PLY, OBJ).
 
 use crate::error::Error;
+use crate::mesh::Mesh;
+use glam::DVec3;
 use std::borrow::Cow;
+use std::fmt;
 use std::path::Path;
 use std::str::FromStr;
 
@@ -25,6 +28,24 @@ pub(crate) fn quoted(token: &str) -> String {
     match token.char_indices().nth(MAX) {
         Some((cut, _)) => format!("`{}...`", &token[..cut]),
         None => format!("`{token}`"),
+    }
+}
+
+/// Vertex `i` of a mesh as `x y z` text: the stored f32 values for a mesh at the origin (the
+/// shortest text that reads back to them), else the absolute position in f64, so that a model
+/// far from the origin keeps its detail.
+pub(crate) struct Position<'a>(pub &'a Mesh, pub usize);
+
+impl fmt::Display for Position<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let Position(mesh, i) = *self;
+        if mesh.origin == DVec3::ZERO {
+            let p = mesh.positions[i];
+            write!(f, "{} {} {}", p.x, p.y, p.z)
+        } else {
+            let p = mesh.absolute(i);
+            write!(f, "{} {} {}", p.x, p.y, p.z)
+        }
     }
 }
 

@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::io::{assemble, text};
 use crate::mesh::Mesh;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -25,7 +25,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         let at = |message: String| Error::parse(path, format!("line {n}"), message);
         values.clear();
         for word in content.split_whitespace() {
-            values.push(text::number::<f32>(word).map_err(at)?);
+            values.push(text::number::<f64>(word).map_err(at)?);
         }
         match first {
             None if values.len() == 3 || values.len() == 6 => first = Some((values.len(), n)),
@@ -35,24 +35,24 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
             }
             Some(_) => {}
         }
-        let p = Vec3::new(values[0], values[1], values[2]);
+        let p = DVec3::new(values[0], values[1], values[2]);
         let point = positions.len();
         positions.push(assemble::finite_position(p).map_err(|m| at(format!("point {point}: {m}")))?);
         if let [_, _, _, nx, ny, nz] = values[..] {
-            let normal = assemble::finite_normal(Vec3::new(nx, ny, nz));
+            let normal = assemble::finite_normal(DVec3::new(nx, ny, nz).as_vec3());
             normals.push(normal.map_err(|m| at(format!("point {point}: {m}")))?);
         }
     }
     assemble::vertex_count_fits(positions.len()).map_err(|m| Error::TooLarge(format!("{}: {m}", path.display())))?;
     let has_normals = first.is_some_and(|(columns, _)| columns == 6);
-    Ok(Mesh::from_points(positions, has_normals.then_some(normals)))
+    Ok(assemble::mesh(positions, has_normals.then_some(normals), Vec::new()))
 }
 
 /// Writes the positions (and normals) of `mesh`; triangles are not part of the format.
 pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh) -> io::Result<()> {
     let normals = mesh.normals.as_deref();
-    for (i, p) in mesh.positions.iter().enumerate() {
-        write!(out, "{} {} {}", p.x, p.y, p.z)?;
+    for i in 0..mesh.positions.len() {
+        write!(out, "{}", text::Position(mesh, i))?;
         if let Some(normals) = normals {
             let n = normals.get(i).copied().unwrap_or(Vec3::ZERO);
             write!(out, " {} {} {}", n.x, n.y, n.z)?;

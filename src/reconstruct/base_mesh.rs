@@ -315,7 +315,7 @@ impl Collapser {
             .filter(|(_, &alive)| alive)
             .map(|(t, _)| t.map(|v| index[v as usize]))
             .collect();
-        BaseMesh { mesh: Mesh { positions, normals: None, triangles }, labels: out_labels }
+        BaseMesh { mesh: Mesh::new(positions, None, triangles), labels: out_labels }
     }
 }
 

@@ -412,7 +412,12 @@ pub fn reconstruct(
     let t3 = Instant::now();
 
     progress.report(0.95, "trimming")?;
-    let mut mesh = Mesh { positions: surface.positions, normals: Some(surface.normals), triangles: surface.triangles };
+    let mut mesh = Mesh {
+        positions: surface.positions,
+        normals: Some(surface.normals),
+        triangles: surface.triangles,
+        origin: cloud.origin,
+    };
     if params.trim > 0.0 {
         stats.trimmed_triangles = trim_far_faces(&mut mesh, &near, params.trim * grid.cell, &threads);
     }
@@ -504,11 +509,7 @@ fn evenly_spread(points: &[Vec3], n: usize) -> Vec<Vec3> {
 /// error(M, S): RMS and max distance from `points` to the surface, over `diagonal`.
 fn sample_error(s: &mut refine::Surface, points: &[Vec3], diagonal: f32, threads: &Threads) -> (f64, f64) {
     // The surface's arrays are lent to a mesh for the measure, not copied.
-    let mesh = Mesh {
-        positions: std::mem::take(&mut s.positions),
-        normals: None,
-        triangles: std::mem::take(&mut s.triangles),
-    };
+    let mesh = Mesh::new(std::mem::take(&mut s.positions), None, std::mem::take(&mut s.triangles));
     let distances: Vec<f64> = threads.run(|| {
         let bvh = TriangleBvh::new(&mesh);
         points.par_iter().map(|&p| f64::from(bvh.distance(p))).collect()

@@ -52,7 +52,7 @@ def test_registered(addon):
     assert hasattr(bpy.types, "VSTREE_PT_panel")
     ok, msg = addon.core.status()
     assert ok, msg
-    assert "libvstree 0.1.1" in msg
+    assert "libvstree 0.1.2" in msg
 
 
 def test_simplify_new_object(scene):

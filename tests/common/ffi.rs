@@ -45,10 +45,10 @@ pub fn read_back(mesh: *const vstree_mesh) -> Mesh {
             assert_eq!(vstree_mesh_copy_normals(mesh, v.as_mut_ptr(), v.len()), vstree_status::Ok);
             v.chunks(3).map(glam::Vec3::from_slice).collect()
         });
-        Mesh {
-            positions: p.chunks(3).map(glam::Vec3::from_slice).collect(),
+        Mesh::new(
+            p.chunks(3).map(glam::Vec3::from_slice).collect(),
             normals,
-            triangles: i.chunks(3).map(|c| [c[0], c[1], c[2]]).collect(),
-        }
+            i.chunks(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        )
     }
 }

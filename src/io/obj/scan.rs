@@ -4,7 +4,7 @@
 //! path, so it favours simplicity over speed.
 
 use crate::io::{assemble, text};
-use glam::Vec3;
+use glam::DVec3;
 use std::str::SplitWhitespace;
 
 /// Data a face corner `v/vt/vn` refers to; the value is the part's position in the corner
@@ -74,8 +74,12 @@ pub(super) fn first_non_finite_use(source: &str, data: Data) -> Option<(usize, S
             continue;
         }
         let problem = numbers::<3>(&mut words).ok().and_then(|xyz| {
-            let v = Vec3::from(xyz);
-            let finite = if data == Data::Normal { assemble::finite_normal(v) } else { assemble::finite_position(v) };
+            let v = DVec3::from(xyz);
+            let finite = if data == Data::Normal {
+                assemble::finite_normal(v.as_vec3()).map(drop)
+            } else {
+                assemble::finite_position(v).map(drop)
+            };
             finite.err().map(|m| format!("{} {} {m}", NAMES[k], values.len()))
         });
         values.push((n, problem));
@@ -114,7 +118,7 @@ fn totals(source: &str) -> Counts {
 }
 
 /// The first `N` numbers of a line; more are ignored, as tobj does.
-fn numbers<const N: usize>(words: &mut SplitWhitespace) -> Result<[f32; N], String> {
+fn numbers<const N: usize>(words: &mut SplitWhitespace) -> Result<[f64; N], String> {
     let mut values = [0.0; N];
     for (found, value) in values.iter_mut().enumerate() {
         let word = words.next().ok_or_else(|| format!("expected {N} numbers, found {found}"))?;
@@ -129,7 +133,7 @@ fn position(mut words: SplitWhitespace) -> Result<(), String> {
     let rest: Vec<&str> = words.collect();
     match rest[..] {
         [] | [_, _, _] => Ok(()),
-        [w] => match text::number::<f32>(w)? {
+        [w] => match text::number::<f64>(w)? {
             0.0 => Err("the weight w is 0".into()),
             _ => Ok(()),
         },

@@ -65,10 +65,6 @@ impl<'a> Tokens<'a> {
 }
 
 impl Cursor for Tokens<'_> {
-    fn coord(&mut self, _: Scalar) -> Result<f32, Fail> {
-        self.parse()
-    }
-
     fn number(&mut self, _: Scalar) -> Result<f64, Fail> {
         self.parse()
     }

@@ -62,12 +62,12 @@ fn read_fixed(cursor: &mut Bytes, element: &Element, layout: &Layout, parts: &mu
         return Ok(());
     }
     parts.reserve_vertices(element.count);
-    let mut coords = [0.0f32; 6];
+    let mut coords = [0.0f64; 6];
     for (item, bytes) in block.chunks_exact(layout.stride).enumerate() {
         let mut decoded = Ok(());
         for &(offset, ty, slot) in &layout.fields {
             match bytes.get(offset..).and_then(|b| ty.decode(b, cursor.big_endian)) {
-                Some(value) => coords[slot] = value as f32,
+                Some(value) => coords[slot] = value,
                 None => decoded = Err(Fail::End),
             }
         }
@@ -96,10 +96,6 @@ impl<'a> Bytes<'a> {
 }
 
 impl Cursor for Bytes<'_> {
-    fn coord(&mut self, ty: Scalar) -> Result<f32, Fail> {
-        self.number(ty).map(|v| v as f32)
-    }
-
     #[inline]
     fn number(&mut self, ty: Scalar) -> Result<f64, Fail> {
         let bytes = self.take(ty.size()).ok_or(Fail::End)?;

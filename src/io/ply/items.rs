@@ -8,7 +8,7 @@ use super::scalar::Scalar;
 use crate::error::{Error, Result};
 use crate::io::assemble;
 use crate::mesh::Mesh;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::path::Path;
 
 /// Why reading a value failed.
@@ -24,9 +24,7 @@ pub(crate) enum Fail {
 
 /// A source of values: tokens of an ASCII body, or bytes of a binary one.
 pub(crate) trait Cursor {
-    /// Reads a value that becomes an `f32` coordinate.
-    fn coord(&mut self, ty: Scalar) -> Result<f32, Fail>;
-    /// Reads any other value (counts, indices, skipped values).
+    /// Reads one value (coordinates, counts, indices, skipped values).
     fn number(&mut self, ty: Scalar) -> Result<f64, Fail>;
     /// Skips `n` values of type `ty` (the items of a list).
     fn skip(&mut self, ty: Scalar, n: usize) -> Result<(), Fail> {
@@ -51,7 +49,8 @@ pub(crate) trait Cursor {
 
 /// Positions, normals and triangles as they are read.
 pub(crate) struct Parts {
-    pub positions: Vec<Vec3>,
+    /// As read, in f64 (see [`assemble::mesh`]).
+    pub positions: Vec<DVec3>,
     pub normals: Option<Vec<Vec3>>,
     pub triangles: Vec<[u32; 3]>,
     /// The vertex count the header declares; face indices are checked against it.
@@ -74,10 +73,10 @@ impl Parts {
 
     /// Adds one vertex from `[x, y, z, nx, ny, nz]`.
     #[inline]
-    pub(crate) fn push_vertex(&mut self, c: [f32; 6]) -> Result<(), String> {
-        let p = assemble::finite_position(Vec3::new(c[0], c[1], c[2]))?;
+    pub(crate) fn push_vertex(&mut self, c: [f64; 6]) -> Result<(), String> {
+        let p = assemble::finite_position(DVec3::new(c[0], c[1], c[2]))?;
         if let Some(normals) = &mut self.normals {
-            normals.push(assemble::finite_normal(Vec3::new(c[3], c[4], c[5]))?);
+            normals.push(assemble::finite_normal(DVec3::new(c[3], c[4], c[5]).as_vec3())?);
         }
         self.positions.push(p);
         Ok(())
@@ -85,7 +84,7 @@ impl Parts {
 
     /// The finished mesh.
     pub(crate) fn into_mesh(self) -> Mesh {
-        Mesh { positions: self.positions, normals: self.normals, triangles: self.triangles }
+        assemble::mesh(self.positions, self.normals, self.triangles)
     }
 }
 
@@ -177,7 +176,7 @@ pub(crate) fn read_element<C: Cursor>(
         Target::Faces => parts.triangles.reserve(room),
         Target::Nothing => {}
     }
-    let mut coords = [0.0f32; 6];
+    let mut coords = [0.0f64; 6];
     let mut polygon = Vec::new();
     let fresh = Expected::new(element);
     for item in 0..element.count {
@@ -205,7 +204,7 @@ fn read_item<C: Cursor>(
     element: &Element,
     job: &Job,
     vertex_count: usize,
-    coords: &mut [f32; 6],
+    coords: &mut [f64; 6],
     polygon: &mut Vec<u32>,
     expected: &mut Expected,
 ) -> Result<(), Fail> {
@@ -214,7 +213,7 @@ fn read_item<C: Cursor>(
         match (property.kind, *role) {
             (Kind::Scalar(ty), Role::Coord(slot)) => {
                 if let Some(c) = coords.get_mut(slot) {
-                    *c = cursor.coord(ty)?;
+                    *c = cursor.number(ty)?;
                 }
             }
             (Kind::Scalar(ty), _) => {

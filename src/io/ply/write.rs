@@ -1,7 +1,9 @@
-//! Writing PLY: `float` positions (and normals), faces as `uchar`-counted index lists.
+//! Writing PLY: `float` positions (`double` for a mesh stored relative to an origin, see
+//! [`Mesh::origin`]) and normals, faces as `uchar`-counted index lists.
 
+use crate::io::text::Position;
 use crate::mesh::Mesh;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::io::{self, Write};
 
 /// Writes `mesh` as PLY, binary little-endian or ASCII. The mesh must pass [`Mesh::check`]
@@ -11,8 +13,8 @@ pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh, ascii: bool) -> io::Resu
     let normals = mesh.normals.as_deref();
     let normal = |i: usize| normals.and_then(|n| n.get(i)).copied().unwrap_or(Vec3::ZERO);
     if ascii {
-        for (i, p) in mesh.positions.iter().enumerate() {
-            write!(out, "{} {} {}", p.x, p.y, p.z)?;
+        for i in 0..mesh.positions.len() {
+            write!(out, "{}", Position(mesh, i))?;
             if normals.is_some() {
                 let n = normal(i);
                 write!(out, " {} {} {}", n.x, n.y, n.z)?;
@@ -23,8 +25,15 @@ pub(crate) fn write<W: Write>(out: &mut W, mesh: &Mesh, ascii: bool) -> io::Resu
             writeln!(out, "3 {a} {b} {c}")?;
         }
     } else {
+        let absolute = mesh.origin != DVec3::ZERO;
         for (i, p) in mesh.positions.iter().enumerate() {
-            out.write_all(&le_bytes(*p))?;
+            if absolute {
+                for value in mesh.absolute(i).to_array() {
+                    out.write_all(&value.to_le_bytes())?;
+                }
+            } else {
+                out.write_all(&le_bytes(*p))?;
+            }
             if normals.is_some() {
                 out.write_all(&le_bytes(normal(i)))?;
             }
@@ -44,7 +53,8 @@ fn write_header<W: Write>(out: &mut W, mesh: &Mesh, ascii: bool) -> io::Result<(
     let format = if ascii { "ascii" } else { "binary_little_endian" };
     writeln!(out, "ply\nformat {format} 1.0\ncomment written by vstree")?;
     writeln!(out, "element vertex {}", mesh.positions.len())?;
-    writeln!(out, "property float x\nproperty float y\nproperty float z")?;
+    let coordinate = if mesh.origin == DVec3::ZERO { "float" } else { "double" };
+    writeln!(out, "property {coordinate} x\nproperty {coordinate} y\nproperty {coordinate} z")?;
     if mesh.normals.is_some() {
         writeln!(out, "property float nx\nproperty float ny\nproperty float nz")?;
     }
