@@ -61,8 +61,8 @@ impl Threads {
     /// slower), so the
     /// count is capped at [`Threads::count_for`]; results are the same for any count.
     pub fn new(count: usize) -> Result<Threads> {
-        if count > 1024 {
-            return Err(Error::param("threads", format!("{count} is absurd (0 = all cores, at most 1024)")));
+        if count > Threads::MAX {
+            return Err(Error::param("threads", format!("{count} is absurd (0 = all cores, at most {})", Threads::MAX)));
         }
         let pool = match count {
             0 => None,
@@ -75,6 +75,9 @@ impl Threads {
         };
         Ok(Threads { pool })
     }
+
+    /// The largest thread count accepted.
+    pub const MAX: usize = 1024;
 
     /// The threads a request for `count` gets: `count` (0 = all cores), at most one per core
     /// the machine runs at once.

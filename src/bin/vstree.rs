@@ -58,22 +58,22 @@ enum Command {
         tree: TreeArgs,
         /// Stop refining once the RMS distance from the samples to the mesh is at most this
         /// fraction of the bounding-box diagonal (0 = refine while the tree has detail left).
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
         target: f64,
         /// Most refinement levels (each one multiplies the triangles by 4).
-        #[arg(long, default_value_t = 6)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = 6)]
         levels: u32,
         /// Remove faces farther than this many grid cells from every sample, so an open scan
         /// gives an open mesh (0 = keep the closed surface). Use it for single range scans:
         /// above 0 the surface that closes the scan is put well behind it, where it is trimmed.
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
         trim: f32,
         /// Re-orient the normals the cloud already has (consistent by spanning-tree
         /// propagation, then facing outward). Clouds without normals always get them estimated.
         #[arg(long)]
         reorient: bool,
         /// Neighbours used to estimate normals (3-256).
-        #[arg(long, default_value_t = vstree::normals::DEFAULT_NEIGHBOURS)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = vstree::normals::DEFAULT_NEIGHBOURS)]
         neighbours: usize,
         /// Write PLY as text instead of binary.
         #[arg(long)]
@@ -124,21 +124,21 @@ struct TreeArgs {
     /// Normal-cone threshold of the height-field test, in [0, 1]: a cell becomes a surface
     /// (2D) node only if every normal's dot product with the mean normal exceeds it. Raise it
     /// for more adaptivity in curved areas.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
     da: f32,
     /// Displacement threshold of the height-field test, in [0, 1]: a cell's height range over
     /// its radius must stay below it. Lower it for more adaptivity in curved areas.
-    #[arg(long, default_value_t = 1.0 / 6.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0 / 6.0)]
     dd: f32,
     /// Deepest tree level (1-30).
-    #[arg(long, default_value_t = 24)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 24)]
     max_depth: u32,
     /// Cells smaller than this fraction of the bounding-box diagonal are not split, in [0, 1):
     /// guards against duplicate points.
-    #[arg(long, default_value_t = TreeParams::default().min_cell_size)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().min_cell_size)]
     min_cell_size: f64,
     /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
     threads: usize,
     /// No progress bar and no report: print nothing but errors (`stats` still prints its
     /// statistics, which are its output).
@@ -360,6 +360,9 @@ fn run(command: Command) -> vstree::Result<()> {
 /// Says when `--threads` asks for more threads than the machine has cores (they would only
 /// take turns), since the library then uses one per core.
 fn say_threads(requested: usize, quiet: bool) {
+    if requested > Threads::MAX {
+        return; // refused with an error as the work starts
+    }
     let used = Threads::count_for(requested);
     if !quiet && requested > used {
         eprintln!("vstree: --threads {requested}: this machine runs {used} at once; using {used}");
@@ -457,6 +460,10 @@ fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &Reconstruct
 /// The `demo` job: both algorithms on generated shapes whose answers are known.
 fn demo(out: &Path) -> vstree::Result<()> {
     use vstree::{shapes, topology};
+    if out.exists() && !out.is_dir() {
+        let e = std::io::Error::new(std::io::ErrorKind::AlreadyExists, "exists and is not a folder: name a folder for --out");
+        return Err(vstree::Error::Io { path: out.to_path_buf(), source: e });
+    }
     std::fs::create_dir_all(out).map_err(|e| vstree::Error::Io { path: out.to_path_buf(), source: e })?;
     println!("== simplification: a bumpy sphere, VS-Tree against octree at the same L2 bound (1e-5)");
     let mesh = shapes::bumpy_sphere(1.0, 0.08, 5.0, 8);

@@ -125,6 +125,8 @@ impl ReconstructParams {
     /// Rejects values outside their documented ranges, naming the parameter.
     pub fn check(&self) -> Result<()> {
         self.tree.check()?;
+        // Even when the cloud's own normals are kept: a value outside the range is a mistake.
+        self.normals.check()?;
         if self.tree.kind != TreeKind::VsTree {
             return Err(Error::param(
                 "tree_kind",
@@ -133,7 +135,7 @@ impl ReconstructParams {
             ));
         }
         if !(self.target_distance.is_finite() && self.target_distance >= 0.0) {
-            return Err(Error::param("target_distance", format!("{}: must be >= 0", self.target_distance)));
+            return Err(Error::param("target_distance", format!("{}: must be a finite number >= 0", self.target_distance)));
         }
         if self.max_levels > 12 {
             return Err(Error::param("max_levels", format!("{}: must be from 0 to 12", self.max_levels)));
@@ -151,7 +153,7 @@ impl ReconstructParams {
             return Err(Error::param("max_grid_depth", format!("{}: must be from 4 to 20", self.max_grid_depth)));
         }
         if !(self.trim.is_finite() && self.trim >= 0.0) {
-            return Err(Error::param("trim", format!("{}: must be >= 0", self.trim)));
+            return Err(Error::param("trim", format!("{}: must be a finite number >= 0", self.trim)));
         }
         Ok(())
     }

@@ -420,3 +420,22 @@ def test_estimate_normals_errors():
         vstree.estimate_normals(points, progress=lambda f, s: False)
     with pytest.raises(TypeError):
         vstree.estimate_normals(points, error=1e-3)
+
+
+def test_a_model_far_from_the_origin_keeps_its_detail(tmp_path):
+    # A unit sphere 1e8 away, as text: float32 alone would round it to a grid of 8 units.
+    p, t, n = torus()
+    # Jittered, so that no point lies exactly on a cell border (the grid's points do), where
+    # rounding at 1e-8 could move it to the neighbouring cell.
+    p = (p + np.random.default_rng(0).normal(0, 1e-3, p.shape)).astype(np.float32)
+    far = p.astype(np.float64) + 1e8
+    path = tmp_path / "far.xyz"
+    path.write_text("".join("%r %r %r %r %r %r\n" % tuple(map(float, (*q, *m))) for q, m in zip(far, n)))
+    cloud = vstree.Mesh.load(str(path))
+    np.testing.assert_allclose(cloud.positions_f64, far, rtol=0, atol=1e-6)
+    assert np.abs(cloud.positions.astype(np.float64) - far).max() > 0.1
+    simplified = vstree.simplify(cloud, error=2e-3).mesh
+    reference = vstree.simplify(vstree.Mesh(p, None, n), error=2e-3).mesh
+    assert simplified.vertex_count == reference.vertex_count
+    # The same clusters (at 1e8 in float32 alone they would be 4 units off).
+    np.testing.assert_allclose(simplified.positions_f64 - 1e8, reference.positions_f64, rtol=0, atol=1e-5)

@@ -213,6 +213,14 @@ class Mesh:
         return out
 
     @property
+    def positions_f64(self):
+        """(n, 3) float64 array (a copy): the exact positions of a model read from a file far
+        from the origin (georeferenced coordinates), which float32 would round."""
+        out = np.empty((self.vertex_count, 3), np.float64)
+        _check(lib.vstree_mesh_copy_positions_f64(self._live(), out.ctypes.data_as(_ffi._F64P), out.size))
+        return out
+
+    @property
     def normals(self):
         """(n, 3) float32 array (a copy), or None when the mesh has none."""
         if not self.has_normals:

@@ -256,6 +256,7 @@ REFINEMENT_STOPPED = {0: "target", 1: "no_detail", 2: "max_levels", 3: "triangle
 # ---- functions ------------------------------------------------------------------------------
 
 _F32P = POINTER(c_float)
+_F64P = POINTER(c_double)
 _U32P = POINTER(c_uint32)
 _SIGNATURES = {
     "vstree_version": (c_char_p, []),
@@ -275,6 +276,7 @@ _SIGNATURES = {
     "vstree_mesh_triangle_count": (c_size_t, [c_void_p]),
     "vstree_mesh_has_normals": (c_int32, [c_void_p]),
     "vstree_mesh_copy_positions": (status_t, [c_void_p, _F32P, c_size_t]),
+    "vstree_mesh_copy_positions_f64": (status_t, [c_void_p, _F64P, c_size_t]),
     "vstree_mesh_copy_normals": (status_t, [c_void_p, _F32P, c_size_t]),
     "vstree_mesh_copy_triangles": (status_t, [c_void_p, _U32P, c_size_t]),
     "vstree_simplify_params_default": (SimplifyParams, []),
