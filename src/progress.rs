@@ -62,7 +62,10 @@ impl Threads {
     /// count is capped at [`Threads::count_for`]; results are the same for any count.
     pub fn new(count: usize) -> Result<Threads> {
         if count > Threads::MAX {
-            return Err(Error::param("threads", format!("{count} is absurd (0 = all cores, at most {})", Threads::MAX)));
+            return Err(Error::param(
+                "threads",
+                format!("{count} is absurd (0 = all cores, at most {})", Threads::MAX),
+            ));
         }
         let pool = match count {
             0 => None,

@@ -461,7 +461,10 @@ fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &Reconstruct
 fn demo(out: &Path) -> vstree::Result<()> {
     use vstree::{shapes, topology};
     if out.exists() && !out.is_dir() {
-        let e = std::io::Error::new(std::io::ErrorKind::AlreadyExists, "exists and is not a folder: name a folder for --out");
+        let e = std::io::Error::new(
+            std::io::ErrorKind::AlreadyExists,
+            "exists and is not a folder: name a folder for --out",
+        );
         return Err(vstree::Error::Io { path: out.to_path_buf(), source: e });
     }
     std::fs::create_dir_all(out).map_err(|e| vstree::Error::Io { path: out.to_path_buf(), source: e })?;

@@ -135,7 +135,10 @@ impl ReconstructParams {
             ));
         }
         if !(self.target_distance.is_finite() && self.target_distance >= 0.0) {
-            return Err(Error::param("target_distance", format!("{}: must be a finite number >= 0", self.target_distance)));
+            return Err(Error::param(
+                "target_distance",
+                format!("{}: must be a finite number >= 0", self.target_distance),
+            ));
         }
         if self.max_levels > 12 {
             return Err(Error::param("max_levels", format!("{}: must be from 0 to 12", self.max_levels)));
