@@ -131,6 +131,11 @@
 #define VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET 3
 
 /**
+ * The largest thread count accepted.
+ */
+#define Threads_MAX 1024
+
+/**
  * The outcome of every fallible call. The numbers are part of the ABI: they never change and
  * are never reused. 13 to 31 are reserved for general statuses added later; 32 to 63 for the
  * statuses the reconstruction and normal-estimation entry points will need.
@@ -1093,9 +1098,12 @@ vstree_status vstree_mesh_create(const float *positions,
  * (points with optional normals). The new handle is written to `*out_mesh`; the caller frees
  * it with vstree_mesh_free().
  *
+ * Only regular files are read (VSTREE_STATUS_IO for a device, FIFO or directory), and a file
+ * whose first bytes are not of its format is refused before the rest is read.
+ *
  * Fails with VSTREE_STATUS_NULL_POINTER, VSTREE_STATUS_INVALID_ARGUMENT (empty path),
  * VSTREE_STATUS_UNSUPPORTED_FORMAT, VSTREE_STATUS_IO, VSTREE_STATUS_PARSE (the message gives
- * the line or element) or VSTREE_STATUS_INVALID_INPUT. Thread-safe.
+ * the line or element) or VSTREE_STATUS_INVALID_INPUT (no vertices). Thread-safe.
  */
 vstree_status vstree_mesh_load(const char *path, struct vstree_mesh **out_mesh);
 
@@ -1118,7 +1126,11 @@ vstree_status vstree_mesh_load_memory(const void *data,
  * Writes `mesh` to the file at `path` (NUL-terminated), in the format its extension names,
  * with normals when the mesh has them (OFF has none); point clouds are written without
  * faces. `flags`: 0, or VSTREE_SAVE_ASCII for text PLY. The file is replaced atomically: on
- * failure it is left as it was. The caller keeps ownership of `mesh`.
+ * failure it is left as it was. As `cp` would: a symbolic link is followed to its target, a
+ * file the process may not write is refused, and a replaced file keeps its permissions; only
+ * regular files are replaced (never a device, FIFO or directory). A mesh far from the origin
+ * (see vstree_mesh_copy_positions_f64()) is written with double coordinates. The caller keeps
+ * ownership of `mesh`.
  *
  * Fails with VSTREE_STATUS_NULL_POINTER, VSTREE_STATUS_INVALID_ARGUMENT (empty path, unknown
  * flag bits), VSTREE_STATUS_UNSUPPORTED_FORMAT or VSTREE_STATUS_IO. Thread-safe (two threads

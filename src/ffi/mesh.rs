@@ -135,9 +135,12 @@ unsafe fn path_arg(path: *const c_char, argument: &str) -> FfiResult<PathBuf> {
 /// (points with optional normals). The new handle is written to `*out_mesh`; the caller frees
 /// it with vstree_mesh_free().
 ///
+/// Only regular files are read (VSTREE_STATUS_IO for a device, FIFO or directory), and a file
+/// whose first bytes are not of its format is refused before the rest is read.
+///
 /// Fails with VSTREE_STATUS_NULL_POINTER, VSTREE_STATUS_INVALID_ARGUMENT (empty path),
 /// VSTREE_STATUS_UNSUPPORTED_FORMAT, VSTREE_STATUS_IO, VSTREE_STATUS_PARSE (the message gives
-/// the line or element) or VSTREE_STATUS_INVALID_INPUT. Thread-safe.
+/// the line or element) or VSTREE_STATUS_INVALID_INPUT (no vertices). Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_mesh_load(path: *const c_char, out_mesh: *mut *mut vstree_mesh) -> vstree_status {
     guard("vstree_mesh_load", || {
@@ -192,7 +195,11 @@ pub unsafe extern "C" fn vstree_mesh_load_memory(
 /// Writes `mesh` to the file at `path` (NUL-terminated), in the format its extension names,
 /// with normals when the mesh has them (OFF has none); point clouds are written without
 /// faces. `flags`: 0, or VSTREE_SAVE_ASCII for text PLY. The file is replaced atomically: on
-/// failure it is left as it was. The caller keeps ownership of `mesh`.
+/// failure it is left as it was. As `cp` would: a symbolic link is followed to its target, a
+/// file the process may not write is refused, and a replaced file keeps its permissions; only
+/// regular files are replaced (never a device, FIFO or directory). A mesh far from the origin
+/// (see vstree_mesh_copy_positions_f64()) is written with double coordinates. The caller keeps
+/// ownership of `mesh`.
 ///
 /// Fails with VSTREE_STATUS_NULL_POINTER, VSTREE_STATUS_INVALID_ARGUMENT (empty path, unknown
 /// flag bits), VSTREE_STATUS_UNSUPPORTED_FORMAT or VSTREE_STATUS_IO. Thread-safe (two threads
