@@ -2,28 +2,14 @@
 //! in f32 relative to an origin of the model's own, so a model 1e6 or 1e8 away gives the same
 //! results as at the origin, and what is written reads back exactly.
 
+mod common;
+
+use common::scratch::Scratch;
 use glam::{DVec3, Vec3};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use vstree::reconstruct::{reconstruct, ReconstructParams};
 use vstree::{io, shapes, simplify, Mesh, Progress, SimplifyParams};
-
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Scratch {
-        let dir = std::env::temp_dir().join(format!("vstree-far-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// `mesh` moved by `offset`, written as text in f64 the way a georeferencing tool would, and
 /// read back: an XYZ file for a cloud, an ASCII PLY for a mesh.
@@ -66,7 +52,7 @@ fn largest_difference(a: &Mesh, b: &Mesh, offset: f64) -> f64 {
 
 #[test]
 fn simplification_is_the_same_wherever_the_model_is() {
-    let scratch = Scratch::new("simplify");
+    let scratch = Scratch::new("far-simplify");
     let sphere = shapes::icosphere(1.0, 4);
     let params = SimplifyParams::default();
     let at_origin = read_moved(&sphere, 0.0, &scratch.0);
@@ -85,7 +71,7 @@ fn simplification_is_the_same_wherever_the_model_is() {
 
 #[test]
 fn reconstruction_is_the_same_wherever_the_cloud_is() {
-    let scratch = Scratch::new("reconstruct");
+    let scratch = Scratch::new("far-reconstruct");
     let cloud = shapes::sample_surface(&shapes::icosphere(1.0, 5), 5000, 11);
     let params = ReconstructParams { max_levels: 2, ..Default::default() };
     let at_origin = read_moved(&cloud, 0.0, &scratch.0);
@@ -102,7 +88,7 @@ fn reconstruction_is_the_same_wherever_the_cloud_is() {
 
 #[test]
 fn float_input_far_away_reads_and_writes_back_exactly() {
-    let scratch = Scratch::new("roundtrip");
+    let scratch = Scratch::new("far-roundtrip");
     // A binary PLY of float32 coordinates around 1e6, detail down to the float's 1/16 there.
     let sphere = shapes::icosphere(1.0, 3);
     let absolute: Vec<Vec3> = sphere.positions.iter().map(|p| *p * 7.0 + Vec3::new(1e6, -2e6, 5e5)).collect();

@@ -1,34 +1,12 @@
 //! Writes replace the target whole or not at all, and leave no temporary files behind.
 
+mod common;
+
+use common::scratch::Scratch;
 use glam::Vec3;
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use vstree::{io, Error, Mesh};
-
-/// A directory under the system temp dir, removed on drop.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Scratch {
-        let dir = std::env::temp_dir().join(format!("vstree-io-{tag}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-
-    fn names(&self) -> Vec<String> {
-        let mut names: Vec<String> =
-            fs::read_dir(&self.0).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-        names.sort();
-        names
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = fs::remove_dir_all(&self.0);
-    }
-}
 
 fn grid(n: u32) -> Mesh {
     let positions = (0..n * n).map(|i| Vec3::new((i % n) as f32, (i / n) as f32, 0.0)).collect();
@@ -45,7 +23,7 @@ fn grid(n: u32) -> Mesh {
 
 #[test]
 fn missing_directory_is_an_io_error_and_creates_nothing() {
-    let scratch = Scratch::new("atomic-missing");
+    let scratch = Scratch::new("io-atomic-missing");
     let target = scratch.0.join("no/such/dir/out.ply");
     let err = io::write(&target, &grid(3)).unwrap_err();
     assert!(matches!(err, Error::Io { ref path, .. } if path == &target), "{err:?}");
@@ -55,7 +33,7 @@ fn missing_directory_is_an_io_error_and_creates_nothing() {
 
 #[test]
 fn successful_writes_leave_only_the_target() {
-    let scratch = Scratch::new("atomic-clean");
+    let scratch = Scratch::new("io-atomic-clean");
     for name in ["a.ply", "b.obj", "c.off", "d.xyz", "e.pwn"] {
         io::write(&scratch.0.join(name), &grid(4)).unwrap();
     }
@@ -64,7 +42,7 @@ fn successful_writes_leave_only_the_target() {
 
 #[test]
 fn writing_over_a_file_replaces_it_whole() {
-    let scratch = Scratch::new("atomic-replace");
+    let scratch = Scratch::new("io-atomic-replace");
     let target = scratch.0.join("m.ply");
     io::write(&target, &grid(50)).unwrap();
     let small = grid(3);
@@ -77,7 +55,7 @@ fn writing_over_a_file_replaces_it_whole() {
 
 #[test]
 fn rejected_writes_leave_the_target_untouched() {
-    let scratch = Scratch::new("atomic-reject");
+    let scratch = Scratch::new("io-atomic-reject");
     let target = scratch.0.join("m.obj");
     fs::write(&target, "precious").unwrap();
     let mut bad = grid(3);
@@ -97,7 +75,7 @@ fn rejected_writes_leave_the_target_untouched() {
 
 #[test]
 fn reading_and_writing_the_same_file_is_safe() {
-    let scratch = Scratch::new("atomic-inplace");
+    let scratch = Scratch::new("io-atomic-inplace");
     let path = scratch.0.join("m.off");
     io::write(&path, &grid(5)).unwrap();
     let mesh = io::read(&path).unwrap();
@@ -118,7 +96,7 @@ fn io_message(result: vstree::Result<()>) -> String {
 #[test]
 fn only_regular_files_are_replaced_and_links_are_followed() {
     use std::os::unix::fs::{symlink, FileTypeExt};
-    let scratch = Scratch::new("atomic-special");
+    let scratch = Scratch::new("io-atomic-special");
     // A FIFO and a device stay what they are.
     let fifo = scratch.0.join("pipe.ply");
     assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
@@ -153,7 +131,7 @@ fn only_regular_files_are_replaced_and_links_are_followed() {
 #[test]
 fn a_replaced_file_keeps_its_permissions() {
     use std::os::unix::fs::PermissionsExt;
-    let scratch = Scratch::new("atomic-mode");
+    let scratch = Scratch::new("io-atomic-mode");
     for mode in [0o600, 0o640, 0o755] {
         let target = scratch.0.join(format!("m{mode:o}.ply"));
         fs::write(&target, "old").unwrap();
@@ -165,7 +143,7 @@ fn a_replaced_file_keeps_its_permissions() {
 
 #[test]
 fn a_name_of_244_characters_is_written() {
-    let scratch = Scratch::new("atomic-long");
+    let scratch = Scratch::new("io-atomic-long");
     let name = format!("{}.ply", "n".repeat(240));
     io::write(&scratch.0.join(&name), &grid(3)).unwrap();
     assert_eq!(scratch.names(), vec![name]);
@@ -178,7 +156,7 @@ fn a_name_of_244_characters_is_written() {
 fn a_read_only_file_is_not_replaced_by_a_user_who_may_not_write_it() {
     use std::os::unix::fs::PermissionsExt;
     use std::os::unix::process::CommandExt;
-    let scratch = Scratch::new("atomic-readonly");
+    let scratch = Scratch::new("io-atomic-readonly");
     fs::set_permissions(&scratch.0, fs::Permissions::from_mode(0o777)).unwrap();
     let input = scratch.0.join("in.off");
     io::write(&input, &grid(20)).unwrap();

@@ -4,29 +4,15 @@
 
 #![cfg(unix)]
 
+mod common;
+
+use common::scratch::Scratch;
 use std::fs;
 use std::io::Read;
 use std::os::unix::fs::symlink;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Scratch {
-        let dir = std::env::temp_dir().join(format!("vstree-bounds-{tag}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = fs::remove_dir_all(&self.0);
-    }
-}
 
 /// What a run of the CLI gave: exit code, stderr, wall time, peak resident memory in bytes.
 struct Run {
@@ -80,7 +66,7 @@ fn run(args: &[&Path], limit: Duration) -> Run {
 
 #[test]
 fn a_huge_file_of_zeros_fails_at_its_first_line_with_little_memory() {
-    let scratch = Scratch::new("zeros");
+    let scratch = Scratch::new("bounds-zeros");
     let output = scratch.0.join("out.ply");
     for extension in ["ply", "xyz", "off", "obj", "pwn"] {
         let input = scratch.0.join(format!("zeros.{extension}"));
@@ -110,7 +96,7 @@ fn a_huge_file_of_zeros_fails_at_its_first_line_with_little_memory() {
 
 #[test]
 fn devices_and_fifos_are_refused_without_blocking() {
-    let scratch = Scratch::new("special");
+    let scratch = Scratch::new("bounds-special");
     let output = scratch.0.join("out.ply");
     let zero = scratch.0.join("z.ply");
     symlink("/dev/zero", &zero).unwrap();

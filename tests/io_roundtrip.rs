@@ -1,28 +1,13 @@
 //! Writing then reading gives the same mesh: exactly for binary PLY, within a tolerance for
 //! text formats. Binary PLY of both byte orders is also read from hand-built byte buffers.
 
+mod common;
+
+use common::scratch::Scratch;
 use glam::Vec3;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use vstree::io::{self, WriteOptions};
 use vstree::Mesh;
-
-/// A directory under the system temp dir, removed on drop.
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(tag: &str) -> Scratch {
-        let dir = std::env::temp_dir().join(format!("vstree-io-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// A square pyramid whose coordinates need all of f32's digits; every vertex is used and
 /// vertices are first used in index order.
@@ -65,7 +50,7 @@ fn cycle(dir: &Path, name: &str, mesh: &Mesh, options: &WriteOptions) -> Mesh {
 
 #[test]
 fn binary_ply_is_exact() {
-    let dir = Scratch::new("rt-binary");
+    let dir = Scratch::new("io-rt-binary");
     for normals in [false, true] {
         let mesh = pyramid(normals);
         assert_eq!(cycle(&dir.0, "m.ply", &mesh, &WriteOptions::default()), mesh);
@@ -76,7 +61,7 @@ fn binary_ply_is_exact() {
 
 #[test]
 fn ascii_ply_round_trips() {
-    let dir = Scratch::new("rt-ascii");
+    let dir = Scratch::new("io-rt-ascii");
     let ascii = WriteOptions { ascii: true };
     for normals in [false, true] {
         let mesh = pyramid(normals);
@@ -88,7 +73,7 @@ fn ascii_ply_round_trips() {
 
 #[test]
 fn point_clouds_are_written_without_faces() {
-    let dir = Scratch::new("rt-cloud");
+    let dir = Scratch::new("io-rt-cloud");
     let cloud = Mesh::from_points(pyramid(true).positions, pyramid(true).normals);
     for (name, ascii) in [("a.ply", true), ("b.ply", false)] {
         let got = cycle(&dir.0, name, &cloud, &WriteOptions { ascii });
@@ -106,7 +91,7 @@ fn point_clouds_are_written_without_faces() {
 
 #[test]
 fn obj_round_trips() {
-    let dir = Scratch::new("rt-obj");
+    let dir = Scratch::new("io-rt-obj");
     for normals in [false, true] {
         let mesh = pyramid(normals);
         assert_close(&cycle(&dir.0, "m.obj", &mesh, &WriteOptions::default()), &mesh, "obj");
@@ -115,7 +100,7 @@ fn obj_round_trips() {
 
 #[test]
 fn off_round_trips_without_normals() {
-    let dir = Scratch::new("rt-off");
+    let dir = Scratch::new("io-rt-off");
     for normals in [false, true] {
         let mesh = pyramid(normals);
         let got = cycle(&dir.0, "m.off", &mesh, &WriteOptions::default());
@@ -126,7 +111,7 @@ fn off_round_trips_without_normals() {
 
 #[test]
 fn xyz_round_trips_points() {
-    let dir = Scratch::new("rt-xyz");
+    let dir = Scratch::new("io-rt-xyz");
     for normals in [false, true] {
         let mesh = pyramid(normals);
         let got = cycle(&dir.0, "m.xyz", &mesh, &WriteOptions::default());

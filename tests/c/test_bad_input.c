@@ -23,6 +23,8 @@
 
 #include <vstree.h>
 
+#include "common.h"
+
 /* ---- fixtures, made once in main ---- */
 
 static char g_dir[2048];
@@ -1593,43 +1595,15 @@ static vstree_mesh *fixture(const float *p, const float *normals, const uint32_t
 }
 
 /* A torus, rings x segments, two triangles per quad. */
-static void make_torus(unsigned rings, unsigned segments) {
-  const float pi = 3.14159265358979f;
-  unsigned i, j;
-  size_t k = 0;
-  g_vertex_count = (size_t)rings * segments;
-  g_triangle_count = 2 * g_vertex_count;
-  g_positions = (float *)malloc(3 * g_vertex_count * sizeof(float));
-  g_normals = (float *)malloc(3 * g_vertex_count * sizeof(float));
-  g_triangles = (uint32_t *)malloc(3 * g_triangle_count * sizeof(uint32_t));
-  if (!g_positions || !g_normals || !g_triangles) exit(2);
-  for (i = 0; i < rings; i++) {
-    float u = 2 * pi * (float)i / (float)rings;
-    for (j = 0; j < segments; j++) {
-      float v = 2 * pi * (float)j / (float)segments;
-      size_t n = (size_t)i * segments + j;
-      g_normals[3 * n + 0] = cosf(v) * cosf(u);
-      g_normals[3 * n + 1] = cosf(v) * sinf(u);
-      g_normals[3 * n + 2] = sinf(v);
-      g_positions[3 * n + 0] = (1.0f + 0.3f * cosf(v)) * cosf(u);
-      g_positions[3 * n + 1] = (1.0f + 0.3f * cosf(v)) * sinf(u);
-      g_positions[3 * n + 2] = 0.3f * sinf(v);
-    }
-  }
-  for (i = 0; i < rings; i++) {
-    for (j = 0; j < segments; j++) {
-      uint32_t a = (uint32_t)(i * segments + j);
-      uint32_t b = (uint32_t)(((i + 1) % rings) * segments + j);
-      uint32_t c = (uint32_t)(((i + 1) % rings) * segments + (j + 1) % segments);
-      uint32_t d = (uint32_t)(i * segments + (j + 1) % segments);
-      g_triangles[k++] = a;
-      g_triangles[k++] = b;
-      g_triangles[k++] = c;
-      g_triangles[k++] = a;
-      g_triangles[k++] = c;
-      g_triangles[k++] = d;
-    }
-  }
+/* The fixture arrays: common.h's torus without bumps. */
+static torus g_torus;
+static void make_fixture_arrays(unsigned rings, unsigned segments) {
+  g_torus = make_torus(rings, segments, 0.0f);
+  g_positions = g_torus.positions;
+  g_normals = g_torus.normals;
+  g_triangles = g_torus.triangles;
+  g_vertex_count = g_torus.vertex_count;
+  g_triangle_count = g_torus.triangle_count;
 }
 
 int main(int argc, char **argv) {
@@ -1646,7 +1620,7 @@ int main(int argc, char **argv) {
     fprintf(stderr, "cannot make %s\n", sub);
     return 2;
   }
-  make_torus(24, 12);
+  make_fixture_arrays(24, 12);
   g_mesh = fixture(g_positions, g_normals, g_triangles, g_triangle_count);
   g_cloud = fixture(g_positions, g_normals, NULL, 0);
   g_cloud_nn = fixture(g_positions, NULL, NULL, 0);
@@ -1678,9 +1652,7 @@ int main(int argc, char **argv) {
   vstree_mesh_free(g_mesh);
   vstree_mesh_free(g_cloud);
   vstree_mesh_free(g_cloud_nn);
-  free(g_positions);
-  free(g_normals);
-  free(g_triangles);
+  free_torus(&g_torus);
   printf("%d passed, %d failed\n", (int)n - failed, failed);
   return failed == 0 ? 0 : 1;
 }

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod ffi;
+pub mod scratch;
 
 use std::path::PathBuf;
 use vstree::{Mesh, MeshSampling, SampleSet};

@@ -12,23 +12,14 @@ import numpy as np
 import pytest
 
 import vstree
+from test_vstree import torus
 
 S = vstree.Status
 
 
 def grid_torus(rings=16, segments=8):
-    """A small closed torus: (positions, triangles, normals)."""
-    u = np.linspace(0, 2 * np.pi, rings, endpoint=False)[:, None]
-    v = np.linspace(0, 2 * np.pi, segments, endpoint=False)[None, :]
-    n = np.stack([np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v) + 0 * u], -1).reshape(-1, 3)
-    p = np.stack([np.cos(u) + 0 * v, np.sin(u) + 0 * v, 0 * u + 0 * v], -1).reshape(-1, 3) + 0.3 * n
-    i, j = np.meshgrid(np.arange(rings), np.arange(segments), indexing="ij")
-    a = i * segments + j
-    b = (i + 1) % rings * segments + j
-    c = (i + 1) % rings * segments + (j + 1) % segments
-    d = i * segments + (j + 1) % segments
-    t = np.concatenate([np.stack([a, b, c], -1), np.stack([a, c, d], -1)]).reshape(-1, 3)
-    return p.astype(np.float32), t.astype(np.uint32), n.astype(np.float32)
+    """A small closed torus without bumps: (positions, triangles, normals)."""
+    return torus(rings, segments, bump=0.0)
 
 
 def sphere_points(count=200):
