@@ -212,3 +212,26 @@ fn an_interrupted_run_leaves_no_temporary_file() {
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// A surface that does not follow the cloud (here the closed blob made of an open hemisphere)
+/// is not passed off as a result: the run says so on stderr.
+#[test]
+fn a_surface_far_from_its_samples_is_reported() {
+    let dir = temp_dir("far-surface");
+    let mut cloud = shapes::sample_surface(&shapes::icosphere(1.0, 5), 20_000, 7);
+    let normals = cloud.normals.take().unwrap();
+    let (positions, normals): (Vec<_>, Vec<_>) =
+        cloud.positions.iter().zip(&normals).filter(|(p, _)| p.z >= 0.0).unzip();
+    let input = dir.join("hemisphere.ply");
+    io::write(&input, &vstree::Mesh::from_points(positions, Some(normals))).unwrap();
+    let run = vstree(&["reconstruct", input.to_str().unwrap(), dir.join("out.ply").to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(stderr.contains("warning: the surface is far from the samples (RMS "), "{stderr}");
+    // A closed sphere from the same sampler gets no warning.
+    let sphere = dir.join("sphere.ply");
+    io::write(&sphere, &shapes::sample_surface(&shapes::icosphere(1.0, 5), 20_000, 7)).unwrap();
+    let run = vstree(&["reconstruct", sphere.to_str().unwrap(), dir.join("sphere-out.ply").to_str().unwrap()]);
+    assert!(run.status.success() && run.stderr.is_empty(), "{}", String::from_utf8_lossy(&run.stderr));
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -102,6 +102,12 @@ enum Command {
     },
 }
 
+/// An RMS sample-to-surface distance above this fraction of the diagonal means the surface
+/// does not follow the cloud at all: a faithful one is within a sample spacing, well below 1%
+/// of the diagonal even for sparse clouds, and the failures seen (a closed blob under an open
+/// hemisphere) are at 30%.
+const FAR_FROM_SAMPLES: f64 = 0.05;
+
 /// The L2 bound to simplify with, and for `stats`, when `--error` is not given.
 const SIMPLIFY_ERROR: f64 = 2e-3;
 
@@ -447,6 +453,13 @@ fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &Reconstruct
     };
     println!("refinement stopped: {stopped}");
     println!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
+    if s.final_error > FAR_FROM_SAMPLES {
+        eprintln!(
+            "warning: the surface is far from the samples (RMS {:.1}% of the diagonal) and does not \
+             represent this cloud (open scans, such as a single view, are not yet reconstructed open)",
+            100.0 * s.final_error
+        );
+    }
     if s.trimmed_triangles > 0 {
         println!("trimmed: {} triangles far from the samples", s.trimmed_triangles);
     }
