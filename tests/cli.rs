@@ -235,3 +235,39 @@ fn a_surface_far_from_its_samples_is_reported() {
     assert!(run.status.success() && run.stderr.is_empty(), "{}", String::from_utf8_lossy(&run.stderr));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// The CLI's defaults are the library's (the C API, Python, MeshLab and Blender take theirs
+/// from it too): every `[default: …]` in `--help` is read back and compared.
+#[test]
+fn help_shows_the_library_defaults() {
+    use vstree::reconstruct::ReconstructParams;
+    use vstree::tree::TreeParams;
+    let default_of = |command: &str, flag: &str| -> String {
+        let help = String::from_utf8(vstree(&[command, "--help"]).stdout).unwrap();
+        let at = help.find(&format!("--{flag} <")).unwrap_or_else(|| panic!("{command} --help lacks --{flag}"));
+        let rest = &help[at..];
+        let start = rest.find("[default: ").unwrap() + "[default: ".len();
+        rest[start..start + rest[start..].find(']').unwrap()].to_string()
+    };
+    let number = |command: &str, flag: &str| default_of(command, flag).parse::<f64>().unwrap();
+    let tree = TreeParams::default();
+    let recon = ReconstructParams::default();
+    for command in ["simplify", "reconstruct", "stats"] {
+        assert_eq!(number(command, "da"), f64::from(tree.d_a), "{command} --da");
+        assert_eq!(number(command, "dd") as f32, tree.d_d, "{command} --dd");
+        assert_eq!(number(command, "max-depth"), f64::from(tree.max_depth), "{command} --max-depth");
+        assert_eq!(number(command, "min-cell-size"), tree.min_cell_size, "{command} --min-cell-size");
+        assert_eq!(default_of(command, "tree"), "vstree");
+        assert_eq!(default_of(command, "metric"), "l2");
+        let error = default_of(command, "error");
+        assert_eq!(
+            error,
+            format!("{:e} to simplify and for stats, {:e} to reconstruct", TreeParams::DEFAULT_ERROR, recon.tree.error)
+        );
+    }
+    assert_eq!(number("reconstruct", "target"), recon.target_distance);
+    assert_eq!(number("reconstruct", "levels"), f64::from(recon.max_levels));
+    assert_eq!(number("reconstruct", "trim"), f64::from(recon.trim));
+    assert_eq!(number("reconstruct", "neighbours"), recon.normals.neighbours as f64);
+    assert_eq!(vstree::SimplifyParams::default().tree.error, TreeParams::DEFAULT_ERROR);
+}

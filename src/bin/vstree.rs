@@ -58,15 +58,15 @@ enum Command {
         tree: TreeArgs,
         /// Stop refining once the RMS distance from the samples to the mesh is at most this
         /// fraction of the bounding-box diagonal (0 = refine while the tree has detail left).
-        #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().target_distance)]
         target: f64,
         /// Most refinement levels (each one multiplies the triangles by 4).
-        #[arg(long, allow_negative_numbers = true, default_value_t = 6)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().max_levels)]
         levels: u32,
         /// Remove faces farther than this many grid cells from every sample, so an open scan
         /// gives an open mesh (0 = keep the closed surface). Use it for single range scans:
         /// above 0 the surface that closes the scan is put well behind it, where it is trimmed.
-        #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
+        #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().trim)]
         trim: f32,
         /// Re-orient the normals the cloud already has (consistent by spanning-tree
         /// propagation, then facing outward). Clouds without normals always get them estimated.
@@ -108,8 +108,9 @@ enum Command {
 /// hemisphere) are at 30%.
 const FAR_FROM_SAMPLES: f64 = 0.05;
 
-/// The L2 bound to simplify with, and for `stats`, when `--error` is not given.
-const SIMPLIFY_ERROR: f64 = 2e-3;
+/// The L2 bound to simplify with, and for `stats`, when `--error` is not given: the
+/// library's, as in C, Python, MeshLab and Blender.
+const SIMPLIFY_ERROR: f64 = TreeParams::DEFAULT_ERROR;
 
 #[derive(Args, Clone)]
 struct TreeArgs {
@@ -124,20 +125,20 @@ struct TreeArgs {
     /// diagonal of its cluster's point); l21: mean squared normal deviation (0-4); density:
     /// samples per cluster.
     /// Larger = coarser output (and, to reconstruct, smoother: it is the de-noising control).
-    /// [default: 2e-3 to simplify and for stats, 1e-5 to reconstruct]
+    /// [default: 1e-3 to simplify and for stats, 1e-5 to reconstruct]
     #[arg(long, allow_negative_numbers = true)]
     error: Option<f64>,
     /// Normal-cone threshold of the height-field test, in [0, 1]: a cell becomes a surface
     /// (2D) node only if every normal's dot product with the mean normal exceeds it. Raise it
     /// for more adaptivity in curved areas.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().d_a)]
     da: f32,
     /// Displacement threshold of the height-field test, in [0, 1]: a cell's height range over
     /// its radius must stay below it. Lower it for more adaptivity in curved areas.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 1.0 / 6.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().d_d)]
     dd: f32,
     /// Deepest tree level (1-30).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 24)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().max_depth)]
     max_depth: u32,
     /// Cells smaller than this fraction of the bounding-box diagonal are not split, in [0, 1):
     /// guards against duplicate points.

@@ -66,7 +66,7 @@ impl Default for TreeParams {
         TreeParams {
             kind: TreeKind::VsTree,
             metric: Metric::L2,
-            error: 1e-3,
+            error: TreeParams::DEFAULT_ERROR,
             d_a: 0.0,
             d_d: 1.0 / 6.0,
             max_depth: 24,
@@ -79,6 +79,10 @@ impl Default for TreeParams {
 pub const MAX_DEPTH: u32 = 30;
 
 impl TreeParams {
+    /// The default L2 bound for simplification (reconstruction has its own, see
+    /// [`crate::reconstruct::ReconstructParams`]).
+    pub const DEFAULT_ERROR: f64 = 1e-3;
+
     /// Rejects values outside their documented ranges, naming the parameter.
     pub fn check(&self) -> Result<()> {
         let positive = self.error.is_finite() && self.error > 0.0;
