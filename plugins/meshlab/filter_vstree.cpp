@@ -193,9 +193,10 @@ vstree_simplify_params simplifyParams(const RichParameterList& par, double diago
 	return p;
 }
 
-void addTreeParams(RichParameterList& pl, double defError, double diagonal)
+// The tree's parameters, with the library's defaults (`d`, from vstree_simplify_params_default()).
+void addTreeParams(RichParameterList& pl, const vstree_simplify_params& d, double diagonal)
 {
-	pl.addParam(RichFloat("error", Scalarm(defError), "Error bound",
+	pl.addParam(RichFloat("error", Scalarm(d.error), "Error bound",
 		"Split threshold per cluster, read according to the metric. L2 (quadric): a relative "
 		"bound, the squared distance from a cluster's point to its samples' tangent planes over "
 		"the squared bounding-box diagonal (1e-3 = planes within about 3% of the diagonal; larger "
@@ -204,16 +205,16 @@ void addTreeParams(RichParameterList& pl, double defError, double diagonal)
 	pl.addParam(RichEnum("tree_kind", 0, kTreeKinds, "Tree",
 		"VS-Tree (octree far from the surface, quadtrees in local frames near it) or a plain Octree."));
 	pl.addParam(RichEnum("metric", 0, kMetrics, "Metric", "The error metric that decides whether a cell is split."));
-	pl.addParam(RichFloat("d_a", 0, "d_a (normal cone)",
+	pl.addParam(RichFloat("d_a", Scalarm(d.d_a), "d_a (normal cone)",
 		"Height-field test: a cell becomes a surface node only if every sample normal has a dot "
 		"product above d_a with the mean normal. Unitless, in [0, 1]."));
-	pl.addParam(RichFloat("d_d", Scalarm(1.0 / 6.0), "d_d (displacement)",
+	pl.addParam(RichFloat("d_d", Scalarm(d.d_d), "d_d (displacement)",
 		"Height-field test: sample heights above the cell's mean plane over its radius must stay "
 		"below d_d. Unitless, in [0, 1]."));
 	pl.addParam(RichEnum("sampling", 0, kSamplings, "Sampling",
 		"Which elements become the tree's samples: vertices (area-weighted normals) or face centers. "
 		"Point clouds always use their points."));
-	pl.addParam(RichInt("max_depth", 24, "Max depth", "Deepest tree level, in [1, 30]."));
+	pl.addParam(RichInt("max_depth", int(d.max_depth), "Max depth", "Deepest tree level, in [1, 30]."));
 }
 
 // Why refinement stopped, for the log (vstree_reconstruct_stats::stopped).
@@ -317,28 +318,30 @@ RichParameterList FilterVstreePlugin::initParameterList(const QAction* a, const 
 	const double diagonal = double(m.cm.bbox.Diag());
 	switch (ID(a)) {
 	case FP_SIMPLIFY:
-		addTreeParams(pl, 1e-3, diagonal);
+		addTreeParams(pl, vstree_simplify_params_default(), diagonal);
 		break;
 	case FP_COLOUR:
-		addTreeParams(pl, 1e-3, diagonal);
+		addTreeParams(pl, vstree_simplify_params_default(), diagonal);
 		pl.addParam(RichEnum("label", 0, kLabelKinds, "Colour by",
 			"Cluster: one colour per cluster (leaf). T-node: one colour per T-node of the T-layer."));
 		break;
-	case FP_RECONSTRUCT:
-		pl.addParam(RichFloat("error", Scalarm(1e-5), "Error bound",
+	case FP_RECONSTRUCT: {
+		const vstree_reconstruct_params d = vstree_reconstruct_params_default();
+		pl.addParam(RichFloat("error", Scalarm(d.error), "Error bound",
 			"The tree's relative L2 bound: squared distance from a cluster's point to its samples' "
 			"tangent planes over the squared bounding-box diagonal. The de-noising control: larger = "
 			"smoother, fewer details."));
 		addDistanceParam(pl, diagonal);
-		pl.addParam(RichInt("levels", 6, "Refinement levels",
+		pl.addParam(RichInt("levels", int(d.max_levels), "Refinement levels",
 			"Most refinement levels, each multiplying the triangle count by 4; in [0, 12]."));
-		pl.addParam(RichFloat("trim", 0, "Trim",
+		pl.addParam(RichFloat("trim", Scalarm(d.trim), "Trim",
 			"Faces farther than this many grid cells from every point are removed (open scans give "
 			"open meshes). 0 keeps the closed surface."));
 		pl.addParam(RichBool("estimate_normals", true, "Estimate normals",
 			"Estimate (and orient outward) the normals the point set lacks. When off, the point set "
 			"must have normals."));
 		break;
+	}
 	default: break;
 	}
 	return pl;

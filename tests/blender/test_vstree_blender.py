@@ -55,6 +55,25 @@ def test_registered(addon):
     assert "libvstree 0.1.2" in msg
 
 
+def test_defaults_are_the_librarys(addon):
+    """The operators' and the sidebar's defaults are the C library's."""
+    lib = addon.core.binding()._ffi.lib
+    simplify = lib.vstree_simplify_params_default()
+    reconstruct = lib.vstree_reconstruct_params_default()
+    sidebar = bpy.context.scene.vstree  # the sidebar's settings (a PropertyGroup on the scene)
+    for rna in (bpy.ops.vstree.simplify.get_rna_type(), bpy.ops.vstree.show_clusters.get_rna_type(), sidebar.bl_rna):
+        assert rna.properties["error"].default == pytest.approx(simplify.error, rel=1e-6), rna
+    props = bpy.ops.vstree.reconstruct.get_rna_type().properties
+    assert props["error"].default == pytest.approx(reconstruct.error, rel=1e-6)
+    assert props["max_levels"].default == reconstruct.max_levels
+    assert props["max_grid_depth"].default == reconstruct.max_grid_depth
+    assert props["trim"].default == reconstruct.trim
+    assert props["neighbours"].default == reconstruct.neighbours
+    settings = sidebar.bl_rna.properties
+    assert settings["recon_error"].default == pytest.approx(reconstruct.error, rel=1e-6)
+    assert settings["max_levels"].default == reconstruct.max_levels and settings["trim"].default == reconstruct.trim
+
+
 def test_simplify_new_object(scene):
     bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32)
     src = bpy.context.active_object

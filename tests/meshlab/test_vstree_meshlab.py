@@ -254,6 +254,30 @@ def test_real_model():
         assert m.face_number() > 1000 and topo(ms)["boundary_edges"] == 0
 
 
+def test_defaults_are_the_librarys():
+    """Every default the filter dialog shows is the C library's (vstree_*_params_default())."""
+    if not hasattr(pymeshlab.MeshSet, "filter_parameter_values"):
+        print("  skipped: this pymeshlab cannot list a filter's default values")
+        return
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bindings", "python"))
+    os.environ["VSTREE_LIBRARY"] = os.path.join(os.path.dirname(PLUGIN), "libvstree.so.0")
+    from vstree import _ffi
+
+    simplify = _ffi.lib.vstree_simplify_params_default()
+    reconstruct = _ffi.lib.vstree_reconstruct_params_default()
+    ms = pymeshlab.MeshSet()
+    sphere(ms)
+    for name in (SIMPLIFY, COLOUR):
+        got = ms.filter_parameter_values(name)
+        # MeshLab keeps its float parameters in float32.
+        assert abs(got["error"] - simplify.error) <= 1e-6 * simplify.error, (name, got["error"])
+        assert abs(got["d_a"] - simplify.d_a) < 1e-6 and abs(got["d_d"] - simplify.d_d) < 1e-6, (name, got)
+        assert got["max_depth"] == simplify.max_depth, (name, got)
+    got = ms.filter_parameter_values(RECONSTRUCT)
+    assert abs(got["error"] - reconstruct.error) <= 1e-6 * reconstruct.error, got["error"]
+    assert got["levels"] == reconstruct.max_levels and got["trim"] == reconstruct.trim, got
+
+
 if __name__ == "__main__":
     failed = 0
     for name, fn in list(globals().items()):
@@ -268,3 +292,4 @@ if __name__ == "__main__":
     print(f"pymeshlab {os.path.dirname(pymeshlab.__file__)}: "
           f"{'ALL PASSED' if failed == 0 else f'{failed} FAILED'}")
     sys.exit(1 if failed else 0)
+

@@ -76,6 +76,17 @@ LABEL_KINDS = [
 ]
 
 
+# The library's defaults (vstree_simplify_params_default(), vstree_reconstruct_params_default()).
+# Properties are declared when the add-on registers, before the library is loaded (on first use,
+# so that enabling never fails), hence the copies; tests/blender checks that they agree.
+SIMPLIFY_ERROR = 1e-3
+RECONSTRUCT_ERROR = 1e-5
+RECONSTRUCT_LEVELS = 6
+GRID_DEPTH = 10
+TRIM = 0.0
+NEIGHBOURS = 16
+
+
 def _error_prop(default):
     return FloatProperty(
         name="Error",
@@ -199,7 +210,7 @@ class VSTREE_OT_simplify(_Worker, bpy.types.Operator):
     bl_label = "VS-Tree Simplify"
     bl_options = {'REGISTER', 'UNDO'}
 
-    error: _error_prop(1e-3)
+    error: _error_prop(SIMPLIFY_ERROR)
     tree_kind: EnumProperty(name="Tree", items=TREE_KINDS, default='vstree', description="Clustering tree")
     metric: EnumProperty(name="Metric", items=METRICS, default='l2', description="Cluster error metric")
     apply_modifiers: BoolProperty(
@@ -254,15 +265,19 @@ class VSTREE_OT_reconstruct(_Worker, bpy.types.Operator):
     bl_label = "VS-Tree Reconstruct"
     bl_options = {'REGISTER', 'UNDO'}
 
-    error: _error_prop(1e-5)
-    max_levels: IntProperty(name="Levels", default=6, min=0, max=12, description="Refinement levels after the base mesh")
-    max_grid_depth: IntProperty(name="Grid Depth", default=10, min=4, max=20, description="Depth of the refinement grid")
+    error: _error_prop(RECONSTRUCT_ERROR)
+    max_levels: IntProperty(
+        name="Levels", default=RECONSTRUCT_LEVELS, min=0, max=12, description="Refinement levels after the base mesh"
+    )
+    max_grid_depth: IntProperty(
+        name="Grid Depth", default=GRID_DEPTH, min=4, max=20, description="Depth of the refinement grid"
+    )
     trim: FloatProperty(
-        name="Trim", default=0.0, min=0.0, max=100.0,
+        name="Trim", default=TRIM, min=0.0, max=100.0,
         description="Remove triangles farther than this many grid cells from the points (0 keeps the closed surface)",
     )
     orient: EnumProperty(name="Orient", items=ORIENTS, default='propagate_outward', description="Orientation of estimated normals")
-    neighbours: IntProperty(name="Neighbours", default=16, min=3, max=256, description="Neighbours for normal estimation")
+    neighbours: IntProperty(name="Neighbours", default=NEIGHBOURS, min=3, max=256, description="Neighbours for normal estimation")
     threads: IntProperty(name="Threads", default=0, min=0, max=1024, description="Worker threads (0 = all cores)")
 
     @classmethod
@@ -302,7 +317,7 @@ class VSTREE_OT_show_clusters(_Worker, bpy.types.Operator):
     bl_label = "VS-Tree Show Clusters"
     bl_options = {'REGISTER', 'UNDO'}
 
-    error: _error_prop(1e-3)
+    error: _error_prop(SIMPLIFY_ERROR)
     tree_kind: EnumProperty(name="Tree", items=TREE_KINDS, default='vstree', description="Clustering tree")
     metric: EnumProperty(name="Metric", items=METRICS, default='l2', description="Cluster error metric")
     kind: EnumProperty(name="Colour By", items=LABEL_KINDS, default='cluster', description="What gets one colour")
@@ -333,17 +348,17 @@ class VSTREE_OT_show_clusters(_Worker, bpy.types.Operator):
 class VSTREE_PG_settings(bpy.types.PropertyGroup):
     """Sidebar parameters, passed to the operators by the panel's buttons."""
 
-    error: _error_prop(1e-3)
+    error: _error_prop(SIMPLIFY_ERROR)
     tree_kind: EnumProperty(name="Tree", items=TREE_KINDS, default='vstree', description="Clustering tree")
     metric: EnumProperty(name="Metric", items=METRICS, default='l2', description="Cluster error metric")
     apply_modifiers: BoolProperty(name="Apply Modifiers", default=True, description="Use the evaluated mesh")
     in_place: BoolProperty(name="In Place", default=False, description="Replace the object's mesh")
     recon_error: FloatProperty(
-        name="Error", default=1e-5, min=1e-9, max=1.0, precision=7, step=1,
+        name="Error", default=RECONSTRUCT_ERROR, min=1e-9, max=1.0, precision=7, step=1,
         description="De-noising control of reconstruction (the tree's L2 bound)",
     )
-    max_levels: IntProperty(name="Levels", default=6, min=0, max=12, description="Refinement levels")
-    trim: FloatProperty(name="Trim", default=0.0, min=0.0, max=100.0, description="Trim distance in grid cells (0 = closed)")
+    max_levels: IntProperty(name="Levels", default=RECONSTRUCT_LEVELS, min=0, max=12, description="Refinement levels")
+    trim: FloatProperty(name="Trim", default=TRIM, min=0.0, max=100.0, description="Trim distance in grid cells (0 = closed)")
     kind: EnumProperty(name="Colour By", items=LABEL_KINDS, default='cluster', description="What gets one colour")
 
 
