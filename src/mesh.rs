@@ -93,11 +93,14 @@ impl Mesh {
         Aabb::of(&self.positions)
     }
 
-    /// Checks what every algorithm relies on: finite coordinates within [`MAX_COORDINATE`],
-    /// normals (if any) as many as positions and finite, triangle indices in range. The error
-    /// names the first offender.
+    /// Checks what every algorithm relies on: finite coordinates within [`MAX_COORDINATE`], a
+    /// finite origin, normals (if any) as many as positions and finite, triangle indices in
+    /// range. The error names the first offender.
     pub fn check(&self) -> Result<()> {
         check_positions(&self.positions, "vertex")?;
+        if !self.origin.is_finite() {
+            return Err(Error::input(format!("the origin {} is not finite", self.origin)));
+        }
         if let Some(normals) = &self.normals {
             if normals.len() != self.positions.len() {
                 return Err(Error::input(format!("{} normals for {} vertices", normals.len(), self.positions.len())));

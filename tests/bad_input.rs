@@ -157,3 +157,10 @@ fn cancelling_stops_with_cancelled() {
     let result = simplify(&mesh, &SimplifyParams::default(), &mut Progress::new(&mut stop));
     assert!(matches!(result, Err(Error::Cancelled)));
 }
+
+#[test]
+fn a_mesh_with_a_non_finite_origin_is_refused() {
+    let mut mesh = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], None, vec![[0, 1, 2]]);
+    mesh.origin = glam::DVec3::new(f64::NAN, 0.0, 0.0);
+    assert!(message(simplify_default(&mesh)).contains("the origin [NaN, 0, 0] is not finite"));
+}
