@@ -3,6 +3,7 @@
 //! its cell; triangles are re-indexed to representatives, and those that collapse or repeat
 //! are dropped. The input's winding is kept, and non-manifold input is fine.
 
+use crate::collapse::Collapser;
 use crate::error::{shown, Error, Result};
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
@@ -20,6 +21,11 @@ pub struct SimplifyParams {
     pub sampling: MeshSampling,
     /// Worker threads; 0 = all cores.
     pub threads: usize,
+    /// Keep the topology: clusters are merged by edge collapses under the link condition
+    /// ([`crate::collapse`]), so a closed 2-manifold gives a closed 2-manifold of the same
+    /// genus and an open one keeps its borders manifold; a cluster the condition keeps in
+    /// pieces keeps a vertex per piece. Off: plain vertex clustering, which may fuse sheets.
+    pub keep_topology: bool,
 }
 
 /// What [`simplify`] did.
@@ -146,7 +152,11 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
         Mesh::from_points(clusters.representatives, Some(clusters.normals))
     } else {
         let labels = vertex_labels(mesh, &samples, &clusters, params.sampling, &tree);
-        collapse(mesh, &labels, &clusters.representatives, &threads)?
+        if params.keep_topology {
+            collapse_keeping_topology(mesh, &labels, &clusters.representatives)
+        } else {
+            collapse(mesh, &labels, &clusters.representatives, &threads)?
+        }
     };
     out.origin = mesh.origin;
     if !mesh.triangles.is_empty() && out.triangles.is_empty() {
@@ -220,6 +230,39 @@ pub fn vertex_labels(
         }
     }
     labels
+}
+
+/// Merges each cluster's vertices by edge collapses that keep the topology (see
+/// [`SimplifyParams::keep_topology`]). A cluster left with one vertex puts it at the cluster's
+/// representative; a cluster kept in pieces leaves each at the mean of what it absorbed.
+fn collapse_keeping_topology(mesh: &Mesh, labels: &[u32], representatives: &[Vec3]) -> Mesh {
+    // Degenerate triangles, and those with a vertex in no cluster, take no part.
+    let proper: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2] && t.iter().all(|&v| labels[v as usize] != NO_CLUSTER))
+        .copied()
+        .collect();
+    let mut used = vec![false; mesh.positions.len()];
+    for &v in proper.iter().flatten() {
+        used[v as usize] = true;
+    }
+    let mut collapser = Collapser::new(&Mesh::new(mesh.positions.clone(), None, proper));
+    for (v, _) in used.iter().enumerate().filter(|(_, &used)| !used) {
+        collapser.remove_vertex(v);
+    }
+    collapser.collapse_within(labels);
+    let (mut out, out_labels) = collapser.finish(labels);
+    let mut pieces = vec![0u32; representatives.len()];
+    for &label in &out_labels {
+        pieces[label as usize] += 1;
+    }
+    for (p, &label) in out.positions.iter_mut().zip(&out_labels) {
+        if pieces[label as usize] == 1 {
+            *p = representatives[label as usize];
+        }
+    }
+    out
 }
 
 /// Re-indexes triangles to clusters, drops collapsed ones and repeats (the first of a repeated

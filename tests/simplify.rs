@@ -17,7 +17,12 @@ fn run(
     sampling: MeshSampling,
     threads: usize,
 ) -> (Mesh, vstree::SimplifyStats) {
-    let params = SimplifyParams { tree: TreeParams { kind, error, ..TreeParams::default() }, sampling, threads };
+    let params = SimplifyParams {
+        tree: TreeParams { kind, error, ..TreeParams::default() },
+        sampling,
+        threads,
+        keep_topology: false,
+    };
     simplify(mesh, &params, &mut Progress::none()).unwrap()
 }
 

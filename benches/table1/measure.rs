@@ -123,7 +123,8 @@ pub struct Simplified {
 /// Simplifies `mesh` with vertex samples `runs` times (the whole call: samples, tree,
 /// clustering) on `threads` threads (0 = all); the median time and the last output.
 pub fn simplified(mesh: &Mesh, kind: TreeKind, bound: f64, threads: usize, runs: usize) -> vstree::Result<Simplified> {
-    let params = SimplifyParams { tree: params(kind, bound), sampling: MeshSampling::Vertices, threads };
+    let params =
+        SimplifyParams { tree: params(kind, bound), sampling: MeshSampling::Vertices, threads, keep_topology: false };
     let mut times = Vec::new();
     let mut out = Mesh::default();
     for _ in 0..runs.max(1) {

@@ -40,6 +40,12 @@ enum Command {
         /// Which mesh elements become samples.
         #[arg(long, value_enum, default_value_t = Sampling::Vertices)]
         sampling: Sampling,
+        /// Keep the topology: clusters merge by edge collapses that keep a closed 2-manifold
+        /// closed and manifold with its genus (and an open one's borders manifold); a cluster
+        /// that cannot merge without changing the topology keeps a vertex per piece, so the
+        /// output may have more vertices than clusters.
+        #[arg(long)]
+        keep_topology: bool,
         /// Write PLY as text instead of binary.
         #[arg(long)]
         ascii: bool,
@@ -291,13 +297,14 @@ fn read_with_normals(path: &Path, threads: usize, quiet: bool) -> vstree::Result
 
 fn run(command: Command) -> vstree::Result<()> {
     match command {
-        Command::Simplify { input, output, tree, sampling, ascii } => {
+        Command::Simplify { input, output, tree, sampling, keep_topology, ascii } => {
             let tree_params = tree.params(SIMPLIFY_ERROR);
             tree_params.check()?; // before reading what may be a large file
             let target = reserve_output(&input, &output)?;
             say_threads(tree.threads, tree.quiet);
             let (mesh, read_s) = timed(|| read_with_normals(&input, tree.threads, tree.quiet))?;
-            let params = SimplifyParams { tree: tree_params, sampling: sampling.into(), threads: tree.threads };
+            let params =
+                SimplifyParams { tree: tree_params, sampling: sampling.into(), threads: tree.threads, keep_topology };
             let (out, stats) = with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
             let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {

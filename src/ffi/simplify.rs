@@ -150,7 +150,7 @@ pub(crate) unsafe fn read_params(pointer: *const vstree_simplify_params) -> FfiR
     if p.threads > 1024 {
         return Err(super::Failure::parameter("threads", format!("{}: must be 0 (all cores) to 1024", p.threads)));
     }
-    Ok(SimplifyParams { tree, sampling, threads: p.threads as usize })
+    Ok(SimplifyParams { tree, sampling, threads: p.threads as usize, keep_topology: false })
 }
 
 /// What a simplification did. Owned by its result (vstree_simplify_result_get_stats()); later

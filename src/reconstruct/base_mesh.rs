@@ -10,9 +10,10 @@
 //! handle), the cluster keeps a few vertices: correct topology comes first.
 
 use super::adjacency::Rows;
+use crate::collapse::Collapser;
 use crate::mesh::Mesh;
 use crate::tree::{NodeKind, VsTree};
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 use std::collections::VecDeque;
 
@@ -107,216 +108,12 @@ pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], neighbours: &Rows,
     let dropped = stray_components(fine, labels, neighbours, cell);
     for (t, tri) in fine.triangles.iter().enumerate() {
         if tri.iter().any(|&v| labels[v as usize] == UNLABELLED || dropped[v as usize]) {
-            c.alive_face[t] = false;
-            for &v in tri {
-                c.alive_vertex[v as usize] = false;
-            }
+            c.remove_face_and_corners(t);
         }
     }
-    // Collapse in rounds, each vertex in at most one collapse per round (a greedy matching),
-    // so clusters shrink evenly and rings stay small; merging everything into one growing
-    // vertex instead makes every link test cost the cluster's whole perimeter.
-    let same_label = |t: &[u32; 3]| (0..3).any(|k| labels[t[k] as usize] == labels[t[(k + 1) % 3] as usize]);
-    let mut candidates: Vec<u32> = (0..c.triangles.len() as u32)
-        .filter(|&t| c.alive_face[t as usize] && same_label(&c.triangles[t as usize]))
-        .collect();
-    let mut touched = vec![false; fine.positions.len()];
-    loop {
-        let mut collapsed = 0usize;
-        touched.fill(false);
-        for &t in &candidates {
-            for k in 0..3 {
-                if !c.alive_face[t as usize] {
-                    break;
-                }
-                let tri = c.triangles[t as usize];
-                let (u, v) = (tri[k], tri[(k + 1) % 3]);
-                if labels[u as usize] == labels[v as usize]
-                    && !touched[u as usize]
-                    && !touched[v as usize]
-                    && c.try_collapse(u.max(v), u.min(v))
-                {
-                    touched[u as usize] = true;
-                    touched[v as usize] = true;
-                    collapsed += 1;
-                }
-            }
-        }
-        if collapsed == 0 {
-            break;
-        }
-        candidates.retain(|&t| c.alive_face[t as usize] && same_label(&c.triangles[t as usize]));
-    }
-    c.finish(labels)
-}
-
-/// Ends a corner list of [`Collapser`].
-const NO_CORNER: u32 = u32::MAX;
-
-/// A triangle mesh under edge collapses: faces die, vertices merge into survivors.
-struct Collapser {
-    triangles: Vec<[u32; 3]>,
-    alive_face: Vec<bool>,
-    /// The corners around each vertex, as linked lists: corner `3 t + k` is corner k of
-    /// triangle t; `head[v]` is v's first, `next[c]` the one after c ([`NO_CORNER`] ends a
-    /// list). Corners of dead faces are dropped lazily. Two flat arrays rather than a `Vec`
-    /// per vertex: a fraction of the memory on millions of vertices.
-    head: Vec<u32>,
-    next: Vec<u32>,
-    alive_vertex: Vec<bool>,
-    sum: Vec<DVec3>,
-    count: Vec<u32>,
-    /// Scratch marks of the link test: a vertex marked `stamp` is in the first ring, one
-    /// marked `stamp + 1` has been seen in the second. Older marks mean "not seen".
-    mark: Vec<u32>,
-    stamp: u32,
-}
-
-impl Collapser {
-    fn new(mesh: &Mesh) -> Collapser {
-        let mut head = vec![NO_CORNER; mesh.positions.len()];
-        let mut next = vec![NO_CORNER; 3 * mesh.triangles.len()];
-        for (t, tri) in mesh.triangles.iter().enumerate() {
-            for (k, &v) in tri.iter().enumerate() {
-                next[3 * t + k] = head[v as usize];
-                head[v as usize] = (3 * t + k) as u32;
-            }
-        }
-        Collapser {
-            triangles: mesh.triangles.clone(),
-            alive_face: vec![true; mesh.triangles.len()],
-            head,
-            next,
-            alive_vertex: vec![true; mesh.positions.len()],
-            sum: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
-            count: vec![1; mesh.positions.len()],
-            mark: vec![0; mesh.positions.len()],
-            stamp: 1,
-        }
-    }
-
-    /// The corners around `v`, dead faces' included.
-    fn corners(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
-        let mut c = self.head[v as usize];
-        std::iter::from_fn(move || {
-            (c != NO_CORNER).then(|| {
-                let this = c;
-                c = self.next[c as usize];
-                this
-            })
-        })
-    }
-
-    /// The live faces around `v`.
-    fn faces(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
-        self.corners(v).map(|c| c / 3).filter(|&f| self.alive_face[f as usize])
-    }
-
-    /// The link test of edge u-v, with marks instead of sorted rings: the sizes of the two
-    /// rings (the other vertices of the live faces around `u`, and around `v`) and how many
-    /// vertices they share.
-    fn rings_and_common(&mut self, u: u32, v: u32) -> (usize, usize, usize) {
-        if self.stamp >= u32::MAX - 2 {
-            self.mark.fill(0);
-            self.stamp = 1;
-        }
-        self.stamp += 2;
-        let (first, seen) = (self.stamp, self.stamp + 1);
-        let mut mark = std::mem::take(&mut self.mark);
-        let mut ring_u = 0;
-        for f in self.faces(u) {
-            for w in self.triangles[f as usize] {
-                if w != u && mark[w as usize] != first {
-                    mark[w as usize] = first;
-                    ring_u += 1;
-                }
-            }
-        }
-        let (mut ring_v, mut common) = (0, 0);
-        for f in self.faces(v) {
-            for w in self.triangles[f as usize] {
-                let m = &mut mark[w as usize];
-                if w == v || *m == seen {
-                    continue;
-                }
-                common += usize::from(*m == first);
-                ring_v += 1;
-                *m = seen;
-            }
-        }
-        self.mark = mark;
-        (ring_u, ring_v, common)
-    }
-
-    /// Merges `u` into `v` if the edge exists and the link condition holds.
-    fn try_collapse(&mut self, u: u32, v: u32) -> bool {
-        if !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
-            return false;
-        }
-        let mut shared = [0u32; 2];
-        let mut shared_count = 0;
-        for f in self.faces(u) {
-            if self.triangles[f as usize].contains(&v) {
-                if shared_count == 2 {
-                    return false; // more than two faces on the edge: not a manifold edge
-                }
-                shared[shared_count] = f;
-                shared_count += 1;
-            }
-        }
-        if shared_count != 2 {
-            return false; // not an edge of a closed manifold (or no edge at all)
-        }
-        let (ring_u, ring_v, common) = self.rings_and_common(u, v);
-        // Link condition; and never shrink a closed component below a tetrahedron.
-        if common != 2 || ring_u + ring_v <= 6 {
-            return false;
-        }
-        for &f in &shared {
-            self.alive_face[f as usize] = false;
-        }
-        // v's new list: its own live corners, then u's, now v's.
-        let mut list = NO_CORNER;
-        for x in [v, u] {
-            let mut c = self.head[x as usize];
-            while c != NO_CORNER {
-                let after = self.next[c as usize];
-                let (f, k) = ((c / 3) as usize, (c % 3) as usize);
-                if self.alive_face[f] {
-                    self.triangles[f][k] = v;
-                    self.next[c as usize] = list;
-                    list = c;
-                }
-                c = after;
-            }
-        }
-        self.head[v as usize] = list;
-        self.head[u as usize] = NO_CORNER;
-        self.alive_vertex[u as usize] = false;
-        let (sum, count) = (self.sum[u as usize], self.count[u as usize]);
-        self.sum[v as usize] += sum;
-        self.count[v as usize] += count;
-        true
-    }
-
-    fn finish(self, labels: &[u32]) -> BaseMesh {
-        let mut index = vec![u32::MAX; self.alive_vertex.len()];
-        let mut positions = Vec::new();
-        let mut out_labels = Vec::new();
-        for (v, _) in self.alive_vertex.iter().enumerate().filter(|(_, &a)| a) {
-            index[v] = positions.len() as u32;
-            positions.push((self.sum[v] / f64::from(self.count[v])).as_vec3());
-            out_labels.push(labels[v]);
-        }
-        let triangles = self
-            .triangles
-            .iter()
-            .zip(&self.alive_face)
-            .filter(|(_, &alive)| alive)
-            .map(|(t, _)| t.map(|v| index[v as usize]))
-            .collect();
-        BaseMesh { mesh: Mesh::new(positions, None, triangles), labels: out_labels }
-    }
+    c.collapse_within(labels);
+    let (mesh, labels) = c.finish(labels);
+    BaseMesh { mesh, labels }
 }
 
 #[cfg(test)]

@@ -51,3 +51,17 @@ pub fn samples_of(mesh: &Mesh) -> SampleSet {
         SampleSet::from_mesh(mesh, MeshSampling::Vertices).unwrap()
     }
 }
+
+/// Every mesh of `../shared/data/corpus` (empty when the folder is absent).
+pub fn corpus_models() -> Vec<(String, Mesh)> {
+    let Some(dir) = data_dir().map(|d| d.join("corpus")).filter(|d| d.is_dir()) else {
+        return Vec::new();
+    };
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| vstree::io::Format::from_path(n.as_ref()).is_some())
+        .collect();
+    names.sort();
+    names.into_iter().map(|n| (n.clone(), vstree::io::read(&dir.join(&n)).unwrap())).collect()
+}

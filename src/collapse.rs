@@ -1,0 +1,264 @@
+//! Topology-preserving clustering of a triangle mesh: every edge whose ends share a label is
+//! collapsed while the link condition (Dey et al. 1999) allows: the neighbours common to both
+//! ends must be exactly the two corners opposite the edge. Such a collapse never changes the
+//! topology of a 2-manifold, so the result keeps the input's genus and stays closed where it
+//! was closed; where the link condition blocks the last collapses of a cluster (a cluster
+//! wrapped around a handle), the cluster keeps a few vertices. Border edges are never
+//! collapsed, nor interior edges joining two border vertices (that would pinch the border).
+//! Used for the reconstruction's base mesh and for simplification that keeps topology.
+
+use crate::mesh::Mesh;
+use glam::DVec3;
+
+/// Ends a corner list of [`Collapser`].
+const NO_CORNER: u32 = u32::MAX;
+
+/// A triangle mesh under edge collapses: faces die, vertices merge into survivors.
+pub(crate) struct Collapser {
+    triangles: Vec<[u32; 3]>,
+    alive_face: Vec<bool>,
+    /// The corners around each vertex, as linked lists: corner `3 t + k` is corner k of
+    /// triangle t; `head[v]` is v's first, `next[c]` the one after c ([`NO_CORNER`] ends a
+    /// list). Corners of dead faces are dropped lazily. Two flat arrays rather than a `Vec`
+    /// per vertex: a fraction of the memory on millions of vertices.
+    head: Vec<u32>,
+    next: Vec<u32>,
+    alive_vertex: Vec<bool>,
+    sum: Vec<DVec3>,
+    count: Vec<u32>,
+    /// Scratch marks of the link test: a vertex marked `stamp` is in the first ring, one
+    /// marked `stamp + 1` has been seen in the second. Older marks mean "not seen".
+    mark: Vec<u32>,
+    stamp: u32,
+    /// Vertices on a border (an edge with one face), which keep their border manifold.
+    border: Vec<bool>,
+}
+
+impl Collapser {
+    pub(crate) fn new(mesh: &Mesh) -> Collapser {
+        let mut head = vec![NO_CORNER; mesh.positions.len()];
+        let mut next = vec![NO_CORNER; 3 * mesh.triangles.len()];
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for (k, &v) in tri.iter().enumerate() {
+                next[3 * t + k] = head[v as usize];
+                head[v as usize] = (3 * t + k) as u32;
+            }
+        }
+        Collapser {
+            triangles: mesh.triangles.clone(),
+            alive_face: vec![true; mesh.triangles.len()],
+            head,
+            next,
+            alive_vertex: vec![true; mesh.positions.len()],
+            sum: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
+            count: vec![1; mesh.positions.len()],
+            mark: vec![0; mesh.positions.len()],
+            stamp: 1,
+            border: border_vertices(mesh),
+        }
+    }
+
+    /// Takes face `t` out, with its three corners' vertices.
+    pub(crate) fn remove_face_and_corners(&mut self, t: usize) {
+        self.alive_face[t] = false;
+        for v in self.triangles[t] {
+            self.alive_vertex[v as usize] = false;
+        }
+    }
+
+    /// Takes vertex `v` out (one that no face uses, which would otherwise survive alone).
+    pub(crate) fn remove_vertex(&mut self, v: usize) {
+        self.alive_vertex[v] = false;
+    }
+
+    /// Collapses every edge whose ends share a label, while the link condition allows. In
+    /// rounds, each vertex in at most one collapse per round (a greedy matching), so clusters
+    /// shrink evenly and rings stay small; merging everything into one growing vertex instead
+    /// makes every link test cost the cluster's whole perimeter.
+    pub(crate) fn collapse_within(&mut self, labels: &[u32]) {
+        let same_label = |t: &[u32; 3]| (0..3).any(|k| labels[t[k] as usize] == labels[t[(k + 1) % 3] as usize]);
+        let mut candidates: Vec<u32> = (0..self.triangles.len() as u32)
+            .filter(|&t| self.alive_face[t as usize] && same_label(&self.triangles[t as usize]))
+            .collect();
+        let mut touched = vec![false; self.alive_vertex.len()];
+        loop {
+            let mut collapsed = 0usize;
+            touched.fill(false);
+            for &t in &candidates {
+                for k in 0..3 {
+                    if !self.alive_face[t as usize] {
+                        break;
+                    }
+                    let tri = self.triangles[t as usize];
+                    let (u, v) = (tri[k], tri[(k + 1) % 3]);
+                    if labels[u as usize] == labels[v as usize]
+                        && !touched[u as usize]
+                        && !touched[v as usize]
+                        && self.try_collapse(u.max(v), u.min(v))
+                    {
+                        touched[u as usize] = true;
+                        touched[v as usize] = true;
+                        collapsed += 1;
+                    }
+                }
+            }
+            if collapsed == 0 {
+                break;
+            }
+            candidates.retain(|&t| self.alive_face[t as usize] && same_label(&self.triangles[t as usize]));
+        }
+    }
+
+    /// The corners around `v`, dead faces' included.
+    fn corners(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        let mut c = self.head[v as usize];
+        std::iter::from_fn(move || {
+            (c != NO_CORNER).then(|| {
+                let this = c;
+                c = self.next[c as usize];
+                this
+            })
+        })
+    }
+
+    /// The live faces around `v`.
+    fn faces(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        self.corners(v).map(|c| c / 3).filter(|&f| self.alive_face[f as usize])
+    }
+
+    /// The link test of edge u-v, with marks instead of sorted rings: the sizes of the two
+    /// rings (the other vertices of the live faces around `u`, and around `v`) and how many
+    /// vertices they share.
+    fn rings_and_common(&mut self, u: u32, v: u32) -> (usize, usize, usize) {
+        if self.stamp >= u32::MAX - 2 {
+            self.mark.fill(0);
+            self.stamp = 1;
+        }
+        self.stamp += 2;
+        let (first, seen) = (self.stamp, self.stamp + 1);
+        let mut mark = std::mem::take(&mut self.mark);
+        let mut ring_u = 0;
+        for f in self.faces(u) {
+            for w in self.triangles[f as usize] {
+                if w != u && mark[w as usize] != first {
+                    mark[w as usize] = first;
+                    ring_u += 1;
+                }
+            }
+        }
+        let (mut ring_v, mut common) = (0, 0);
+        for f in self.faces(v) {
+            for w in self.triangles[f as usize] {
+                let m = &mut mark[w as usize];
+                if w == v || *m == seen {
+                    continue;
+                }
+                common += usize::from(*m == first);
+                ring_v += 1;
+                *m = seen;
+            }
+        }
+        self.mark = mark;
+        (ring_u, ring_v, common)
+    }
+
+    /// Merges `u` into `v` if the edge exists and the link condition holds.
+    fn try_collapse(&mut self, u: u32, v: u32) -> bool {
+        if !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
+            return false;
+        }
+        let mut shared = [0u32; 2];
+        let mut shared_count = 0;
+        for f in self.faces(u) {
+            if self.triangles[f as usize].contains(&v) {
+                if shared_count == 2 {
+                    return false; // more than two faces on the edge: not a manifold edge
+                }
+                shared[shared_count] = f;
+                shared_count += 1;
+            }
+        }
+        if shared_count != 2 {
+            return false; // a border or non-manifold edge (or no edge at all)
+        }
+        if self.border[u as usize] && self.border[v as usize] {
+            return false; // an interior edge between two border vertices: would pinch the border
+        }
+        let (ring_u, ring_v, common) = self.rings_and_common(u, v);
+        // Link condition; and never shrink a closed component below a tetrahedron.
+        if common != 2 || ring_u + ring_v <= 6 {
+            return false;
+        }
+        for &f in &shared {
+            self.alive_face[f as usize] = false;
+        }
+        // v's new list: its own live corners, then u's, now v's.
+        let mut list = NO_CORNER;
+        for x in [v, u] {
+            let mut c = self.head[x as usize];
+            while c != NO_CORNER {
+                let after = self.next[c as usize];
+                let (f, k) = ((c / 3) as usize, (c % 3) as usize);
+                if self.alive_face[f] {
+                    self.triangles[f][k] = v;
+                    self.next[c as usize] = list;
+                    list = c;
+                }
+                c = after;
+            }
+        }
+        self.head[v as usize] = list;
+        self.head[u as usize] = NO_CORNER;
+        self.alive_vertex[u as usize] = false;
+        self.border[v as usize] |= self.border[u as usize];
+        let (sum, count) = (self.sum[u as usize], self.count[u as usize]);
+        self.sum[v as usize] += sum;
+        self.count[v as usize] += count;
+        true
+    }
+
+    /// The mesh of the surviving vertices, each at the mean of the vertices it absorbed, and
+    /// the survivors' labels.
+    pub(crate) fn finish(self, labels: &[u32]) -> (Mesh, Vec<u32>) {
+        let mut index = vec![u32::MAX; self.alive_vertex.len()];
+        let mut positions = Vec::new();
+        let mut out_labels = Vec::new();
+        for (v, _) in self.alive_vertex.iter().enumerate().filter(|(_, &a)| a) {
+            index[v] = positions.len() as u32;
+            positions.push((self.sum[v] / f64::from(self.count[v])).as_vec3());
+            out_labels.push(labels[v]);
+        }
+        let triangles = self
+            .triangles
+            .iter()
+            .zip(&self.alive_face)
+            .filter(|(_, &alive)| alive)
+            .map(|(t, _)| t.map(|v| index[v as usize]))
+            .collect();
+        (Mesh::new(positions, None, triangles), out_labels)
+    }
+}
+
+/// The vertices on an edge that only one face has.
+fn border_vertices(mesh: &Mesh) -> Vec<bool> {
+    let mut edges: Vec<(u32, u32)> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    let mut border = vec![false; mesh.positions.len()];
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j] == edges[i] {
+            j += 1;
+        }
+        if j - i == 1 {
+            border[edges[i].0 as usize] = true;
+            border[edges[i].1 as usize] = true;
+        }
+        i = j;
+    }
+    border
+}
