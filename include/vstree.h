@@ -131,11 +131,6 @@
 #define VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET 3
 
 /**
- * The largest thread count accepted.
- */
-#define Threads_MAX 1024
-
-/**
  * The outcome of every fallible call. The numbers are part of the ABI: they never change and
  * are never reused. 13 to 31 are reserved for general statuses added later; 32 to 63 for the
  * statuses the reconstruction and normal-estimation entry points will need.

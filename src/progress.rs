@@ -80,6 +80,7 @@ impl Threads {
     }
 
     /// The largest thread count accepted.
+    /// cbindgen:ignore
     pub const MAX: usize = 1024;
 
     /// The threads a request for `count` gets: `count` (0 = all cores), at most one per core

@@ -81,6 +81,7 @@ pub const MAX_DEPTH: u32 = 30;
 impl TreeParams {
     /// The default L2 bound for simplification (reconstruction has its own, see
     /// [`crate::reconstruct::ReconstructParams`]).
+    /// cbindgen:ignore
     pub const DEFAULT_ERROR: f64 = 1e-3;
 
     /// Rejects values outside their documented ranges, naming the parameter.
