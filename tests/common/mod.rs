@@ -27,16 +27,24 @@ pub fn load(name: &str) -> Option<Mesh> {
 
 /// Every model in `../shared/data` (empty when the folder is absent).
 pub fn all_models() -> Vec<(String, Mesh)> {
-    let Some(dir) = data_dir() else {
-        return Vec::new();
-    };
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
+    data_dir().map_or_else(Vec::new, |dir| models_in(&dir))
+}
+
+/// Every model of a format vstree reads in `dir`, by name.
+fn models_in(dir: &std::path::Path) -> Vec<(String, Mesh)> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
         .filter(|n| vstree::io::Format::from_path(n.as_ref()).is_some())
         .collect();
     names.sort();
-    names.into_iter().map(|n| (n.clone(), load(&n).unwrap())).collect()
+    names
+        .into_iter()
+        .map(|n| {
+            let mesh = vstree::io::read(&dir.join(&n)).unwrap_or_else(|e| panic!("{n}: {e}"));
+            (n, mesh)
+        })
+        .collect()
 }
 
 /// The samples the library would use: mesh vertices, or the cloud's points with their normals
@@ -54,14 +62,5 @@ pub fn samples_of(mesh: &Mesh) -> SampleSet {
 
 /// Every mesh of `../shared/data/corpus` (empty when the folder is absent).
 pub fn corpus_models() -> Vec<(String, Mesh)> {
-    let Some(dir) = data_dir().map(|d| d.join("corpus")).filter(|d| d.is_dir()) else {
-        return Vec::new();
-    };
-    let mut names: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .filter(|n| vstree::io::Format::from_path(n.as_ref()).is_some())
-        .collect();
-    names.sort();
-    names.into_iter().map(|n| (n.clone(), vstree::io::read(&dir.join(&n)).unwrap())).collect()
+    data_dir().map(|d| d.join("corpus")).filter(|d| d.is_dir()).map_or_else(Vec::new, |dir| models_in(&dir))
 }
