@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
-"""Peers of the VS-Tree reconstruction, for `benches/table2`: PyMeshLab's screened Poisson
-(`generate_surface_reconstruction_screened_poisson`) at depth 8 and 10, PyMeshLab's ball
-pivoting (`generate_surface_reconstruction_ball_pivoting`), and Open3D's Poisson
-(`TriangleMesh.create_from_point_cloud_poisson`), on a point cloud with oriented normals.
+"""Peers of the VS-Tree reconstruction, for `benches/table2` and `benches/corpus`: PyMeshLab's
+screened Poisson (`generate_surface_reconstruction_screened_poisson`) at depth 8 and 10,
+PyMeshLab's ball pivoting (`generate_surface_reconstruction_ball_pivoting`), and Open3D's
+Poisson (`TriangleMesh.create_from_point_cloud_poisson`) at depth 8 and 10, plain or with
+density trimming (the vertices of the lowest 10% of Open3D's densities removed, for open
+scans), on a point cloud with oriented normals.
 
-Usage (normally called by `cargo bench --bench table2 -- --peers`):
+Usage (normally called by `cargo bench --bench table2 -- --peers` or `--bench corpus`):
 
     python3 benches/reconstruct_peers.py --input target/bench-table2/igea-cloud.ply \
         --name igea --runs 3 --out-dir target/bench-table2 \
-        [--methods meshlab-spsr8,meshlab-spsr10,meshlab-bpa,open3d-poisson10]
+        [--methods meshlab-spsr8,meshlab-spsr10,meshlab-bpa,open3d-poisson10,...]
 
 The input is the cloud with the normals vstree uses (the bench writes it), so every method
 sees the same points and normals. For every method it writes `<out-dir>/<name>-<method>.ply`
@@ -46,7 +48,18 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 PYMESHLAB = "pymeshlab==2025.7.post1"
 OPEN3D = "open3d-cpu==0.20.0"
-METHODS = ["meshlab-spsr8", "meshlab-spsr10", "meshlab-bpa", "open3d-poisson10"]
+METHODS = [
+    "meshlab-spsr8",
+    "meshlab-spsr10",
+    "meshlab-bpa",
+    "open3d-poisson8",
+    "open3d-poisson10",
+    "open3d-poisson8-trim",
+    "open3d-poisson10-trim",
+]
+# Density trimming: the vertices whose Open3D density is below this quantile are removed (and
+# their faces), the usual way to open a Poisson surface where the samples end.
+TRIM_QUANTILE = 0.10
 THREADS = os.cpu_count() or 1
 
 
@@ -101,24 +114,31 @@ def bpa(base, runs, path):
     return seconds, "auto radius, 1 thread"
 
 
-def open3d_poisson(o3d, cloud_path, depth, runs, path):
-    """Open3D's Poisson at `depth`, other parameters at their defaults, all cores."""
+def open3d_poisson(o3d, cloud_path, depth, trim, runs, path):
+    """Open3D's Poisson at `depth`, other parameters at their defaults, all cores; with `trim`,
+    the vertices of the lowest TRIM_QUANTILE of its densities removed (timed too)."""
     cloud = o3d.io.read_point_cloud(str(cloud_path))
     if not cloud.has_normals():
         raise RuntimeError(f"{cloud_path}: no normals read")
 
     def call():
         start = time.perf_counter()
-        mesh, _densities = o3d.geometry.TriangleMesh.create_from_point_cloud_poisson(
+        mesh, densities = o3d.geometry.TriangleMesh.create_from_point_cloud_poisson(
             cloud, depth=depth, n_threads=-1
         )
+        if trim:
+            import numpy
+
+            densities = numpy.asarray(densities)
+            mesh.remove_vertices_by_mask(densities < numpy.quantile(densities, TRIM_QUANTILE))
         return time.perf_counter() - start, mesh
 
     seconds, mesh = timed(runs, call)
     o3d.io.write_triangle_mesh(
         str(path), mesh, write_ascii=False, write_vertex_normals=False, write_vertex_colors=False
     )
-    return seconds, f"depth {depth}, {THREADS} threads"
+    trimmed = f", lowest {TRIM_QUANTILE:.0%} of densities removed" if trim else ""
+    return seconds, f"depth {depth}{trimmed}, {THREADS} threads"
 
 
 def main():
@@ -136,7 +156,7 @@ def main():
     if unknown:
         parser.error(f"unknown methods: {', '.join(unknown)}")
 
-    optional = [("open3d", OPEN3D)] if "open3d-poisson10" in methods else []
+    optional = [("open3d", OPEN3D)] if any(m.startswith("open3d") for m in methods) else []
     ensure(required=[("pymeshlab", PYMESHLAB)], optional=optional)  # re-runs this in the venv
 
     import pymeshlab
@@ -163,7 +183,9 @@ def main():
             if o3d is None:
                 skip(method, f"{OPEN3D} unavailable: {why}")
                 continue
-            seconds, parameters = open3d_poisson(o3d, args.input, 10, args.runs, path)
+            depth = 8 if method.startswith("open3d-poisson8") else 10
+            trim = method.endswith("-trim")
+            seconds, parameters = open3d_poisson(o3d, args.input, depth, trim, args.runs, path)
         print(f"peer\t{method}\t{seconds:.6f}\t{parameters}\t{path}", flush=True)
 
 

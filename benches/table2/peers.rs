@@ -2,33 +2,16 @@
 //! Poisson), run by `benches/reconstruct_peers.py` on the cloud with vstree's normals; their
 //! outputs are read back so the Rust side measures them like its own.
 
+use crate::common::reconstruction::run_peers;
+pub use crate::common::reconstruction::Outcome;
 use crate::common::report::thousands;
-use std::ffi::OsString;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Every peer, in the table's order.
 pub const METHODS: [&str; 4] = ["meshlab-spsr8", "meshlab-spsr10", "meshlab-bpa", "open3d-poisson10"];
 
 /// The screened Poisson run the speed and distance targets compare with.
 pub const REFERENCE: &str = "meshlab-spsr10";
-
-/// What one peer did on one input.
-#[derive(Clone, Debug)]
-pub enum Outcome {
-    Ran {
-        method: String,
-        /// Median time of the reconstruction call.
-        seconds: f64,
-        /// Its parameters, for the record.
-        parameters: String,
-        /// The mesh it wrote.
-        output: PathBuf,
-    },
-    Skipped {
-        method: String,
-        reason: String,
-    },
-}
 
 /// How to run the peers.
 pub struct Setup<'a> {
@@ -68,25 +51,5 @@ impl Setup<'_> {
 /// Runs the peers `methods` on the cloud file `cloud` (with normals). The script's progress
 /// goes to this process's stderr.
 pub fn run(setup: &Setup, methods: &[String], cloud: &Path, name: &str) -> Result<Vec<Outcome>, String> {
-    let mut args: Vec<OsString> = vec!["--input".into(), cloud.into(), "--name".into(), name.into()];
-    args.extend(["--runs".into(), setup.runs.to_string().into(), "--out-dir".into(), setup.out_dir.into()]);
-    args.extend(["--methods".into(), methods.join(",").into()]);
-    let records = crate::common::peers::run(setup.root, "reconstruct_peers.py", &args)?;
-    Ok(records.iter().filter_map(|r| parse(r)).collect())
-}
-
-/// A `peer <method> <seconds> <parameters> <path>` or `skip <method> <reason>` record.
-fn parse(record: &[String]) -> Option<Outcome> {
-    match record {
-        [kind, method, seconds, parameters, path] if kind == "peer" => Some(Outcome::Ran {
-            method: method.clone(),
-            seconds: seconds.parse().ok()?,
-            parameters: parameters.clone(),
-            output: PathBuf::from(path),
-        }),
-        [kind, method, reason] if kind == "skip" => {
-            Some(Outcome::Skipped { method: method.clone(), reason: format!("skipped: {reason}") })
-        }
-        _ => None,
-    }
+    run_peers(setup.root, setup.out_dir, methods, setup.runs, cloud, name)
 }

@@ -1,0 +1,549 @@
+//! Reconstruction on shapes nothing was tuned on: points sampled on the 16 closed meshes of
+//! `../shared/data/corpus` and on the closed meshes of `../shared/data`, at each size, with
+//! exact normals, without normals and with noisy positions; and synthetic cases with a known
+//! answer (an open hemisphere, single-view scans of corpus meshes, a unit sphere at the origin
+//! and far from it). Every output, vstree's and with `--peers` screened Poisson's (PyMeshLab
+//! and Open3D, depth 8 and 10, on the same points with the same normals), is measured by the
+//! same code against the mesh the points came from: genus and components, Chamfer and
+//! Hausdorff distance, angles, valence, folds. Prints a Markdown report and writes it into
+//! `docs/benchmarks.md` between the `corpus` markers.
+//!
+//! ```text
+//! cargo bench --bench corpus -- [--peers] [--sizes 200000,1000000] [--models bear,igea] [--quick]
+//!     [--reduced] [--no-synthetic] [--methods open3d-poisson8] [--runs N] [--peer-runs N]
+//!     [--max-peer-points N] [--data ../shared/data] [--threads N] [--no-write]
+//! ```
+
+#[path = "../common/mod.rs"]
+mod common;
+mod inputs;
+mod measure;
+mod report;
+
+use common::cli::{list, names, number, shown};
+use common::inputs::short_count;
+use common::reconstruction::{reconstruction, run_peers, Outcome};
+use glam::DVec3;
+use inputs::{Truth, Variant};
+use measure::{quality, Samples};
+use report::{Context, PeerRow, Report, Row};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use vstree::normals::{ensure_normals, NormalParams};
+use vstree::reconstruct::ReconstructParams;
+use vstree::{io, Mesh, Progress};
+
+const USAGE: &str = "\
+usage: cargo bench --bench corpus -- [options]
+  --peers               also run the peers (benches/reconstruct_peers.py): screened Poisson at depth
+                        8 and 10 from PyMeshLab and from Open3D, and on open inputs Open3D's with
+                        density trimming
+  --sizes A,B           points sampled on each mesh (default 200000,1000000)
+  --models A,B          only these meshes (stems; default: the 16 of the corpus and the closed
+                        ones of the data directory; or none); single views only of those among them
+  --quick               20k points, 3 models (bull, femur, triceratops), small synthetic cases
+  --reduced             sizes above the smallest only for the corpus's clean variant
+  --no-synthetic        skip the hemisphere, single views and spheres
+  --methods A,B         only these peers (default: all; see reconstruct_peers.py --help)
+  --big-methods A,B     only these peers on clouds larger than the smallest size (default: --methods)
+  --runs N              timed runs of vstree per input (default 1)
+  --peer-runs N         timed runs of each peer (default 1)
+  --max-peer-points N   skip the peers on clouds with more points (default 2000000)
+  --data DIR            data directory (default ../shared/data, relative to the project root)
+  --threads N           vstree's worker threads, 0 = all cores (default 0)
+  --no-write            print the report only, do not update docs/benchmarks.md";
+
+/// The peers on every input, and on open inputs only.
+pub const CLOSED_PEERS: [&str; 4] = ["meshlab-spsr8", "open3d-poisson8", "meshlab-spsr10", "open3d-poisson10"];
+pub const OPEN_PEERS: [&str; 2] = ["open3d-poisson8-trim", "open3d-poisson10-trim"];
+/// Points of the synthetic cases: hemispheres, and each single view (before culling) and sphere.
+const HEMISPHERES: [usize; 2] = [10_000, 200_000];
+const SYNTHETIC: usize = 200_000;
+const QUICK_POINTS: usize = 20_000;
+/// vstree's trimming on open inputs, in grid cells (as `tests/reconstruct.rs` uses on a scan).
+pub const TRIM_CELLS: f32 = 3.0;
+
+/// Command-line options.
+pub struct Options {
+    peers: bool,
+    sizes: Vec<usize>,
+    models: Option<Vec<String>>,
+    quick: bool,
+    reduced: bool,
+    synthetic: bool,
+    methods: Vec<String>,
+    big_methods: Option<Vec<String>>,
+    runs: usize,
+    peer_runs: usize,
+    max_peer_points: usize,
+    data: PathBuf,
+    threads: usize,
+    write: bool,
+}
+
+impl Options {
+    fn parse(args: &[String], root: &Path) -> Result<Options, String> {
+        let mut o = Options {
+            peers: false,
+            sizes: vec![200_000, 1_000_000],
+            models: None,
+            quick: false,
+            reduced: false,
+            synthetic: true,
+            methods: CLOSED_PEERS.iter().chain(&OPEN_PEERS).map(|m| m.to_string()).collect(),
+            big_methods: None,
+            runs: 1,
+            peer_runs: 1,
+            max_peer_points: 2_000_000,
+            data: root.join("../shared/data"),
+            threads: 0,
+            write: true,
+        };
+        let mut sizes_given = false;
+        let mut it = args.iter();
+        while let Some(arg) = it.next() {
+            let mut value = || it.next().ok_or_else(|| format!("{arg} needs a value"));
+            match arg.as_str() {
+                "--peers" => o.peers = true,
+                "--quick" => o.quick = true,
+                "--reduced" => o.reduced = true,
+                "--no-synthetic" => o.synthetic = false,
+                "--no-write" => o.write = false,
+                "--sizes" => {
+                    o.sizes = list(value()?)?;
+                    sizes_given = true;
+                }
+                "--models" => {
+                    let v = value()?;
+                    o.models = Some(if v == "none" { Vec::new() } else { names(v) });
+                }
+                "--methods" => o.methods = names(value()?),
+                "--big-methods" => o.big_methods = Some(names(value()?)),
+                "--runs" => o.runs = number(value()?)?,
+                "--peer-runs" => o.peer_runs = number(value()?)?,
+                "--max-peer-points" => o.max_peer_points = number(value()?)?,
+                "--threads" => o.threads = number(value()?)?,
+                "--data" => o.data = PathBuf::from(value()?),
+                other => return Err(format!("unknown option {other}\n{USAGE}")),
+            }
+        }
+        if o.quick {
+            if !sizes_given {
+                o.sizes = vec![QUICK_POINTS];
+            }
+            if o.models.is_none() {
+                o.models = Some(inputs::QUICK_MODELS.iter().map(|m| m.to_string()).collect());
+            }
+        }
+        if o.runs == 0 || o.peer_runs == 0 {
+            return Err("run counts must be at least 1".into());
+        }
+        if o.sizes.is_empty() || o.sizes.contains(&0) {
+            return Err("--sizes: give at least one size above 0".into());
+        }
+        o.sizes.sort_unstable();
+        o.sizes.dedup();
+        let known: Vec<&str> = CLOSED_PEERS.iter().chain(&OPEN_PEERS).copied().collect();
+        if let Some(bad) = o.methods.iter().chain(o.big_methods.iter().flatten()).find(|m| !known.contains(&m.as_str()))
+        {
+            return Err(format!("unknown peer {bad}: the peers are {}", known.join(", ")));
+        }
+        let models = inputs::models(&o.data);
+        if let Some(bad) = o.models.iter().flatten().find(|m| !models.iter().any(|k| k.name == **m)) {
+            let known: Vec<&str> = models.iter().map(|k| k.name.as_str()).collect();
+            return Err(format!("unknown model {bad}: the models are {}", known.join(", ")));
+        }
+        Ok(o)
+    }
+
+    fn wants(&self, model: &str) -> bool {
+        self.models.as_ref().is_none_or(|only| only.iter().any(|m| m == model))
+    }
+
+    /// The (size, variant) pairs of a sampled model.
+    fn samplings(&self, corpus: bool) -> Vec<(usize, Variant)> {
+        let smallest = self.sizes[0];
+        let mut out = Vec::new();
+        for &size in &self.sizes {
+            for variant in Variant::SAMPLED {
+                if !self.reduced || size == smallest || (corpus && variant == Variant::Clean) {
+                    out.push((size, variant));
+                }
+            }
+        }
+        out
+    }
+
+    fn hemispheres(&self) -> Vec<usize> {
+        if self.quick {
+            vec![HEMISPHERES[0], QUICK_POINTS]
+        } else {
+            HEMISPHERES.to_vec()
+        }
+    }
+
+    fn synthetic_points(&self) -> usize {
+        if self.quick {
+            QUICK_POINTS
+        } else {
+            SYNTHETIC
+        }
+    }
+}
+
+fn main() {
+    let args = common::cli::bench_args();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    if common::cli::wants_help(&args) {
+        println!("{USAGE}");
+        return;
+    }
+    let options = match Options::parse(&args, &root) {
+        Ok(o) => o,
+        Err(message) => {
+            eprintln!("{message}");
+            std::process::exit(2);
+        }
+    };
+    match run(&options, &root, common::cli::command("corpus", &args)) {
+        Ok(report) => common::report::publish(&root, "corpus", &report.markdown(), options.write),
+        Err(e) => {
+            eprintln!("corpus: {e}");
+            std::process::exit(1);
+        }
+    }
+}
+
+/// One input to reconstruct and what it is measured against.
+struct Case<'a> {
+    /// The model or shape, e.g. `bear`, `hemisphere`, `bear (view)`, `sphere @1e6`.
+    name: String,
+    variant: Variant,
+    corpus: bool,
+    truth: &'a Truth,
+    /// As vstree and the peers read it (far from the origin for the offset spheres).
+    cloud: Mesh,
+    /// Where the truth's origin is in the cloud's coordinates.
+    offset: DVec3,
+}
+
+impl Case<'_> {
+    /// A file name: `bear-200k-clean`.
+    fn stem(&self) -> String {
+        let variant = match self.variant {
+            Variant::Clean => "clean",
+            Variant::NoNormals => "nonormals",
+            Variant::Noisy => "noisy",
+            Variant::Open => "open",
+            Variant::Text => "text",
+        };
+        let name: String =
+            self.name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '-' }).collect();
+        format!("{name}-{}-{variant}", short_count(self.cloud.positions.len())).replace("--", "-")
+    }
+}
+
+/// Everything the run needs besides the options.
+struct Bench<'a> {
+    o: &'a Options,
+    root: &'a Path,
+    out_dir: PathBuf,
+    command: String,
+    load_start: String,
+    rows: Vec<Row>,
+    notes: Vec<String>,
+    done: usize,
+    total: usize,
+    start: Instant,
+}
+
+/// Runs every measurement and gathers the report.
+fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
+    let load_start = common::report::load_average();
+    let out_dir = root.join("target").join("bench-corpus");
+    std::fs::create_dir_all(&out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
+    let models: Vec<inputs::Model> = inputs::models(&o.data).into_iter().filter(|m| o.wants(&m.name)).collect();
+    let views: Vec<&str> =
+        if o.synthetic { inputs::SINGLE_VIEWS.iter().copied().filter(|m| o.wants(m)).collect() } else { Vec::new() };
+    let synthetic = if o.synthetic { o.hemispheres().len() + 1 + inputs::OFFSETS.len() } else { 0 };
+    let total = models.iter().map(|m| o.samplings(m.corpus).len()).sum::<usize>() + views.len() + synthetic;
+    let mut bench = Bench {
+        o,
+        root,
+        out_dir,
+        command,
+        load_start,
+        rows: Vec::new(),
+        notes: Vec::new(),
+        done: 0,
+        total,
+        start: Instant::now(),
+    };
+
+    let mut skipped = Vec::new();
+    for model in &models {
+        let truth = match inputs::load(model) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("corpus: skipping {}: {e}", model.path.display());
+                skipped.push(format!("{} ({e})", shown(&model.path, root)));
+                bench.total -= o.samplings(model.corpus).len() + usize::from(views.contains(&model.name.as_str()));
+                continue;
+            }
+        };
+        for (size, variant) in o.samplings(model.corpus) {
+            let cloud = inputs::sampled(&truth, size, variant);
+            let case = Case {
+                name: model.name.clone(),
+                variant,
+                corpus: model.corpus,
+                truth: &truth,
+                cloud,
+                offset: DVec3::ZERO,
+            };
+            bench.measure(case);
+        }
+        if views.contains(&model.name.as_str()) {
+            let (visible, cloud) = inputs::single_view(&truth, o.synthetic_points());
+            let name = format!("{} (view)", model.name);
+            bench.measure(Case {
+                name,
+                variant: Variant::Open,
+                corpus: false,
+                truth: &visible,
+                cloud,
+                offset: DVec3::ZERO,
+            });
+        }
+    }
+    if !skipped.is_empty() {
+        bench.notes.push(format!("Left out: {}.", skipped.join("; ")));
+    }
+    if o.synthetic {
+        for count in o.hemispheres() {
+            let (truth, cloud) = inputs::hemisphere(count);
+            let name = "hemisphere".to_string();
+            bench.measure(Case {
+                name,
+                variant: Variant::Open,
+                corpus: false,
+                truth: &truth,
+                cloud,
+                offset: DVec3::ZERO,
+            });
+        }
+        let (truth, cloud) = inputs::sphere(o.synthetic_points());
+        for offset in std::iter::once(0.0).chain(inputs::OFFSETS) {
+            let name = if offset == 0.0 { "sphere".to_string() } else { format!("sphere @{offset:e}") };
+            let offset = DVec3::splat(offset);
+            let path = bench.out_dir.join(format!("sphere-{}.xyz", offset.x));
+            match inputs::through_text(&cloud, offset, &path) {
+                Ok(read) => bench.measure(Case {
+                    name,
+                    variant: Variant::Text,
+                    corpus: false,
+                    truth: &truth,
+                    cloud: read,
+                    offset,
+                }),
+                Err(e) => bench.notes.push(format!("{name}: {e}")),
+            }
+        }
+    }
+    let context = bench.context(None);
+    Ok(Report { rows: bench.rows, context })
+}
+
+impl Bench<'_> {
+    /// The report's context now; `partial` adds a note that the run is not finished.
+    fn context(&self, partial: Option<String>) -> Context {
+        let o = self.o;
+        Context {
+            command: self.command.clone(),
+            peers: o.peers,
+            runs: o.runs,
+            peer_runs: o.peer_runs,
+            threads: o.threads,
+            load_start: self.load_start.clone(),
+            load_end: common::report::load_average(),
+            seconds: self.start.elapsed().as_secs_f64(),
+            notes: self.notes.iter().cloned().chain(partial).collect(),
+        }
+    }
+
+    /// The report so far, in `target/bench-corpus/partial.md`, so a run stopped early still
+    /// leaves its rows.
+    fn checkpoint(&mut self) {
+        let note = format!("Partial: {} of {} inputs done.", self.done, self.total);
+        let report = Report { rows: std::mem::take(&mut self.rows), context: self.context(Some(note)) };
+        if let Err(e) = std::fs::write(self.out_dir.join("partial.md"), report.markdown()) {
+            eprintln!("corpus: cannot write the partial report: {e}");
+        }
+        self.rows = report.rows;
+    }
+
+    /// vstree's row of one case and, with `--peers`, the peers'.
+    fn measure(&mut self, case: Case) {
+        self.done += 1;
+        let points = case.cloud.positions.len();
+        let label = format!("{} {} {}", case.name, short_count(points), case.variant.name());
+        eprintln!(
+            "corpus: [{}/{}, {:.0} s] {label}: vstree",
+            self.done,
+            self.total,
+            self.start.elapsed().as_secs_f64()
+        );
+        let open = case.truth.open;
+        let params = ReconstructParams {
+            trim: if open { TRIM_CELLS } else { 0.0 },
+            threads: self.o.threads,
+            ..ReconstructParams::default()
+        };
+        let local_cloud = inputs::local(&case.cloud, case.offset);
+        let samples = open.then(|| Samples::new(&local_cloud.positions));
+        let stem = case.stem();
+        let vstree = match reconstruction(&case.cloud, &params, self.o.runs) {
+            Ok(rec) => {
+                if let Err(e) = io::write(&self.out_dir.join(format!("{stem}-vstree.ply")), &rec.mesh) {
+                    eprintln!("corpus: cannot write vstree's output: {e}");
+                }
+                let q = quality(&inputs::local(&rec.mesh, case.offset), case.truth, samples.as_ref());
+                eprintln!(
+                    "corpus:   vstree {:.2} s, {} vertices, genus {:?} (truth {:?}), Chamfer {:.4}%",
+                    rec.seconds.total,
+                    q.vertices,
+                    q.genus,
+                    case.truth.genus,
+                    100.0 * q.distances.chamfer().unwrap_or(f64::NAN)
+                );
+                Ok((rec.seconds, rec.stats.levels.len(), q))
+            }
+            Err(e) => {
+                eprintln!("corpus:   vstree failed: {e}");
+                Err(e.to_string())
+            }
+        };
+        let mut row = Row {
+            name: case.name.clone(),
+            variant: case.variant,
+            points,
+            corpus: case.corpus,
+            open,
+            truth_genus: case.truth.genus,
+            truth_components: case.truth.components,
+            vstree,
+            peers: Vec::new(),
+        };
+        if self.o.peers {
+            self.peers(&case, &params, &stem, samples.as_ref(), &mut row);
+        }
+        self.rows.push(row);
+        self.checkpoint();
+    }
+
+    /// The peers on the case's points with the normals vstree uses.
+    fn peers(&mut self, case: &Case, params: &ReconstructParams, stem: &str, samples: Option<&Samples>, row: &mut Row) {
+        let wanted = match &self.o.big_methods {
+            Some(big) if row.points > self.o.sizes[0] => big,
+            _ => &self.o.methods,
+        };
+        let methods: Vec<String> = CLOSED_PEERS
+            .iter()
+            .chain(if case.truth.open { &OPEN_PEERS[..] } else { &[] })
+            .filter(|m| wanted.iter().any(|k| k == *m))
+            .map(|m| m.to_string())
+            .collect();
+        if methods.is_empty() {
+            return;
+        }
+        if row.points > self.o.max_peer_points {
+            let reason = format!("skipped: more than {} points (`--max-peer-points`)", self.o.max_peer_points);
+            row.peers.extend(methods.into_iter().map(|method| PeerRow {
+                method,
+                ran: false,
+                seconds: None,
+                parameters: String::new(),
+                quality: Err(reason.clone()),
+            }));
+            return;
+        }
+        // The normals vstree uses: its own estimate where the cloud has none (deterministic,
+        // the same parameters), the given ones otherwise; written to a PLY file (in doubles
+        // for a cloud far from the origin) that every peer reads.
+        let mut oriented = case.cloud.clone();
+        let normal_params = NormalParams { threads: self.o.threads, ..params.normals };
+        if let Err(e) = ensure_normals(&mut oriented, &normal_params, &mut Progress::none()) {
+            self.notes.push(format!("Peers on {} {}: normals: {e}", case.name, case.variant.name()));
+            return;
+        }
+        let cloud_path = self.out_dir.join(format!("{stem}-cloud.ply"));
+        if let Err(e) = io::write(&cloud_path, &oriented) {
+            self.notes.push(format!("Peers on {}: {e}", case.name));
+            return;
+        }
+        drop(oriented);
+        let mut outcomes = run_peers(self.root, &self.out_dir, &methods, self.o.peer_runs, &cloud_path, stem);
+        if let (Err(e), true) = (&outcomes, methods.len() > 1) {
+            // One method may crash the script (a segmentation fault far from the origin): run
+            // each on its own, so the others are measured and the crash is a failed row.
+            eprintln!("corpus:   {e}: running the peers one by one");
+            let mut each = Vec::new();
+            for method in &methods {
+                match run_peers(
+                    self.root,
+                    &self.out_dir,
+                    std::slice::from_ref(method),
+                    self.o.peer_runs,
+                    &cloud_path,
+                    stem,
+                ) {
+                    Ok(o) => each.extend(o),
+                    Err(e) => row.peers.push(PeerRow {
+                        method: method.clone(),
+                        ran: true,
+                        seconds: None,
+                        parameters: String::new(),
+                        quality: Err(format!("failed: {}", e.rsplit('/').next().unwrap_or(&e))),
+                    }),
+                }
+            }
+            outcomes = Ok(each);
+        }
+        match outcomes {
+            Ok(outcomes) => {
+                for outcome in outcomes {
+                    let peer = peer_row(outcome, case, samples);
+                    if let (Some(s), Ok(q)) = (peer.seconds, &peer.quality) {
+                        eprintln!(
+                            "corpus:   {} {s:.2} s, {} vertices, genus {:?}, Chamfer {:.4}%",
+                            peer.method,
+                            q.vertices,
+                            q.genus,
+                            100.0 * q.distances.chamfer().unwrap_or(f64::NAN)
+                        );
+                    }
+                    row.peers.push(peer);
+                }
+            }
+            Err(e) => self.notes.push(format!("Peers on {} {}: {e}", case.name, case.variant.name())),
+        }
+        row.peers.sort_by_key(|p| CLOSED_PEERS.iter().chain(&OPEN_PEERS).position(|m| *m == p.method));
+        let _ = std::fs::remove_file(&cloud_path);
+    }
+}
+
+/// A peer's row: its output read back, put in the truth's frame and measured.
+fn peer_row(outcome: Outcome, case: &Case, samples: Option<&Samples>) -> PeerRow {
+    match outcome {
+        Outcome::Ran { method, seconds, parameters, output } => {
+            let quality = match io::read(&output) {
+                Ok(mesh) => Ok(quality(&inputs::local(&mesh, case.offset), case.truth, samples)),
+                Err(e) => Err(format!("cannot read {}: {e}", output.display())),
+            };
+            PeerRow { method, ran: true, seconds: Some(seconds), parameters, quality }
+        }
+        Outcome::Skipped { method, reason } => {
+            PeerRow { method, ran: false, seconds: None, parameters: String::new(), quality: Err(reason) }
+        }
+    }
+}
