@@ -3,8 +3,9 @@
 //! ends must be exactly the two corners opposite the edge. Such a collapse never changes the
 //! topology of a 2-manifold, so the result keeps the input's genus and stays closed where it
 //! was closed; where the link condition blocks the last collapses of a cluster (a cluster
-//! wrapped around a handle), the cluster keeps a few vertices. Border edges are never
-//! collapsed, nor interior edges joining two border vertices (that would pinch the border).
+//! wrapped around a handle), the cluster keeps a few vertices. On an open mesh, border edges
+//! collapse along the border under the same condition (the border closed by a dummy vertex);
+//! interior edges joining two border vertices never collapse (that would pinch the border).
 //! Used for the reconstruction's base mesh and for simplification that keeps topology.
 
 use crate::mesh::Mesh;
@@ -74,12 +75,25 @@ impl Collapser {
     /// Collapses every edge whose ends share a label, while the link condition allows. In
     /// rounds, each vertex in at most one collapse per round (a greedy matching), so clusters
     /// shrink evenly and rings stay small; merging everything into one growing vertex instead
-    /// makes every link test cost the cluster's whole perimeter.
+    /// makes every link test cost the cluster's whole perimeter. Border edges go first: a
+    /// cluster's stretch of border shrinks to one vertex before its inside merges into it, or
+    /// else an inside vertex merged into two border vertices leaves an edge between them
+    /// across the inside, which no collapse may then take (it would pinch the border).
     pub(crate) fn collapse_within(&mut self, labels: &[u32]) {
+        self.collapse_rounds(labels, true);
+        self.collapse_rounds(labels, false);
+    }
+
+    /// [`Collapser::collapse_within`]'s rounds, over border edges only or over every edge.
+    fn collapse_rounds(&mut self, labels: &[u32], border_only: bool) {
         let same_label = |t: &[u32; 3]| (0..3).any(|k| labels[t[k] as usize] == labels[t[(k + 1) % 3] as usize]);
         let mut candidates: Vec<u32> = (0..self.triangles.len() as u32)
             .filter(|&t| self.alive_face[t as usize] && same_label(&self.triangles[t as usize]))
             .collect();
+        if border_only {
+            candidates
+                .retain(|&t| self.triangles[t as usize].iter().filter(|&&v| self.border[v as usize]).count() >= 2);
+        }
         let mut touched = vec![false; self.alive_vertex.len()];
         loop {
             let mut collapsed = 0usize;
@@ -94,7 +108,8 @@ impl Collapser {
                     if labels[u as usize] == labels[v as usize]
                         && !touched[u as usize]
                         && !touched[v as usize]
-                        && self.try_collapse(u.max(v), u.min(v))
+                        && (!border_only || self.border[u as usize] && self.border[v as usize])
+                        && (self.try_collapse(u.max(v), u.min(v)) || border_only && self.cut_ear(u, v))
                     {
                         touched[u as usize] = true;
                         touched[v as usize] = true;
@@ -162,6 +177,26 @@ impl Collapser {
         (ring_u, ring_v, common)
     }
 
+    /// Where `u` and `v` are border vertices joined by an inside edge, one of whose faces is
+    /// an ear (its third corner has no other face: the border runs u, tip, v), takes the ear
+    /// off: the border then runs along u-v, which can collapse. A disk stays a disk. The tip
+    /// is of another label (or its border edge to `u` or `v` would have collapsed), and the
+    /// ear is what keeps `u` and `v`'s stretch of border from shrinking to one vertex.
+    fn cut_ear(&mut self, u: u32, v: u32) -> bool {
+        if !self.border[u as usize] || !self.border[v as usize] {
+            return false;
+        }
+        let ear = self.faces(u).find(|&f| {
+            let t = self.triangles[f as usize];
+            t.contains(&v) && t.iter().any(|&w| w != u && w != v && self.faces(w).count() == 1)
+        });
+        let Some(f) = ear else { return false };
+        let tip = self.triangles[f as usize].into_iter().find(|&w| w != u && w != v).unwrap_or(u);
+        self.alive_face[f as usize] = false;
+        self.alive_vertex[tip as usize] = false;
+        true
+    }
+
     /// Merges `u` into `v` if the edge exists and the link condition holds.
     fn try_collapse(&mut self, u: u32, v: u32) -> bool {
         if !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
@@ -178,18 +213,25 @@ impl Collapser {
                 shared_count += 1;
             }
         }
-        if shared_count != 2 {
-            return false; // a border or non-manifold edge (or no edge at all)
-        }
-        if self.border[u as usize] && self.border[v as usize] {
-            return false; // an interior edge between two border vertices: would pinch the border
-        }
+        let on_border = match shared_count {
+            // A border edge. Its ends are border vertices by definition.
+            1 => true,
+            2 if self.border[u as usize] && self.border[v as usize] => {
+                return false; // an interior edge between two border vertices: would pinch the border
+            }
+            2 => false,
+            _ => return false, // no edge at all
+        };
         let (ring_u, ring_v, common) = self.rings_and_common(u, v);
-        // Link condition; and never shrink a closed component below a tetrahedron.
-        if common != 2 || ring_u + ring_v <= 6 {
+        // Link condition: the common neighbours are the corners opposite the edge (one on a
+        // border edge: seen with a dummy vertex closing the border, the other is the dummy).
+        // And never shrink a closed component below a tetrahedron, an open one below two
+        // triangles.
+        let (corners, smallest) = if on_border { (1, 4) } else { (2, 6) };
+        if common != corners || ring_u + ring_v <= smallest {
             return false;
         }
-        for &f in &shared {
+        for &f in &shared[..shared_count] {
             self.alive_face[f as usize] = false;
         }
         // v's new list: its own live corners, then u's, now v's.
@@ -210,10 +252,19 @@ impl Collapser {
         self.head[v as usize] = list;
         self.head[u as usize] = NO_CORNER;
         self.alive_vertex[u as usize] = false;
-        self.border[v as usize] |= self.border[u as usize];
-        let (sum, count) = (self.sum[u as usize], self.count[u as usize]);
-        self.sum[v as usize] += sum;
-        self.count[v as usize] += count;
+        // A border vertex stays at the mean of the border vertices it absorbed, so the
+        // border keeps its place.
+        let (u, v) = (u as usize, v as usize);
+        match (self.border[u], self.border[v]) {
+            (false, true) => {}
+            (true, false) => (self.sum[v], self.count[v]) = (self.sum[u], self.count[u]),
+            _ => {
+                let (sum, count) = (self.sum[u], self.count[u]);
+                self.sum[v] += sum;
+                self.count[v] += count;
+            }
+        }
+        self.border[v] |= self.border[u];
         true
     }
 
