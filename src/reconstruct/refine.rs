@@ -104,6 +104,9 @@ impl<'t> Refiner<'t> {
             .flat_map_iter(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
             .collect();
         edges.par_sort_unstable();
+        // A border edge (one face) gives a border vertex, which stays on its edge's curve:
+        // sliding or smoothing it towards its neighbours would pull the border inward.
+        let on_border: Vec<bool> = edges.chunk_by(|a, b| a == b).map(|run| run.len() == 1).collect();
         edges.dedup();
         let mid = |a: u32, b: u32| old + edges.binary_search(&(a.min(b), a.max(b))).unwrap_or(0) as u32;
 
@@ -154,16 +157,24 @@ impl<'t> Refiner<'t> {
             })
             .collect();
         let mut displaced = vec![false; out.positions.len()];
+        let mut border = vec![false; out.positions.len()];
+        for (k, &b) in on_border.iter().enumerate() {
+            border[old as usize + k] = b;
+        }
         for &(v, leaf) in &moves {
             let v = v as usize;
-            out.positions[v] = self.place_on_leaf(leaf as usize, out.positions[v]);
+            out.positions[v] = if border[v] {
+                self.onto_leaf(leaf as usize, out.positions[v])
+            } else {
+                self.place_on_leaf(leaf as usize, out.positions[v])
+            };
             if self.normal[leaf as usize] != Vec3::ZERO {
                 out.normals[v] = self.normal[leaf as usize];
             }
             displaced[v] = true;
         }
 
-        smooth_tangentially(&mut out, old, &displaced);
+        smooth_tangentially(&mut out, old, &displaced, &border);
         self.project_undisplaced(&mut out, old as usize, &displaced);
         self.unfold(&mut out, old as usize);
         (out, LevelStats { new_vertices: placed.len(), displaced: moves.len() })
@@ -467,8 +478,8 @@ pub(crate) fn pn_midpoint(pa: Vec3, na: Vec3, pb: Vec3, nb: Vec3) -> (Vec3, Vec3
 
 /// Moves each new vertex that was not displaced towards the mean of its neighbours that are
 /// final (old vertices and displaced ones), within its tangent plane only. Each new vertex has
-/// at least its edge's two ends as final neighbours.
-fn smooth_tangentially(s: &mut Surface, first_new: u32, displaced: &[bool]) {
+/// at least its edge's two ends as final neighbours. Border vertices stay on their edge's curve.
+fn smooth_tangentially(s: &mut Surface, first_new: u32, displaced: &[bool], border: &[bool]) {
     let is_final = |v: u32| v < first_new || displaced[v as usize];
     let mut sum = vec![Vec3::ZERO; s.positions.len()];
     let mut count = vec![0u32; s.positions.len()];
@@ -483,7 +494,7 @@ fn smooth_tangentially(s: &mut Surface, first_new: u32, displaced: &[bool]) {
         }
     }
     for v in first_new as usize..s.positions.len() {
-        if !displaced[v] && count[v] > 0 {
+        if !displaced[v] && !border[v] && count[v] > 0 {
             let n = s.normals[v];
             let delta = sum[v] / count[v] as f32 - s.positions[v];
             s.positions[v] += delta - n * n.dot(delta);
