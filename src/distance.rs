@@ -547,6 +547,21 @@ impl PointBvh {
         found.is_some_and(|(_, d2)| d2.sqrt() <= radius)
     }
 
+    /// Whether a point whose input index passes `keep` lies within `radius` of `p`; like
+    /// [`PointBvh::any_within`], it skips everything farther than `radius`.
+    pub fn any_within_among(&self, p: Vec3, radius: f32, keep: impl Fn(u32) -> bool) -> bool {
+        let (below, enough) = ((radius * PRUNE_MARGIN).powi(2), (radius / PRUNE_MARGIN).powi(2));
+        let distance2 = |position: usize| {
+            if keep(self.bvh.order[position]) {
+                self.points[position].distance_squared(p)
+            } else {
+                f32::INFINITY
+            }
+        };
+        let found = self.bvh.search(p, distance2, below, enough);
+        found.is_some_and(|(_, d2)| d2.sqrt() <= radius)
+    }
+
     /// `distance(p)` when that is at most `cap`, else `f32::INFINITY`: the search skips
     /// everything farther than `cap`. NaN when `p` has a NaN coordinate.
     pub fn distance_within(&self, p: Vec3, cap: f32) -> f32 {

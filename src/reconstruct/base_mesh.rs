@@ -111,6 +111,12 @@ pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], neighbours: &Rows,
             c.remove_face_and_corners(t);
         }
     }
+    // Vertices of faces taken out before (an open M0's unsupported part).
+    for v in 0..fine.positions.len() {
+        if neighbours.of(v as u32).is_empty() {
+            c.remove_vertex(v);
+        }
+    }
     c.collapse_within(labels);
     let (mesh, labels) = c.finish(labels);
     BaseMesh { mesh, labels }
@@ -148,6 +154,27 @@ mod tests {
             assert_eq!(r.genus(), Some(genus));
             assert!(base.mesh.positions.len() < 40, "{} vertices left", base.mesh.positions.len());
         }
+    }
+
+    #[test]
+    fn an_open_mesh_collapses_along_its_border() {
+        // The upper half of a sphere in four clusters (the quadrants around z): a few vertices
+        // each, and the border stays one manifold loop.
+        let sphere = crate::shapes::icosphere(1.0, 4);
+        let upper = sphere
+            .triangles
+            .iter()
+            .copied()
+            .filter(|t| t.iter().all(|&v| sphere.positions[v as usize].z > -1e-6))
+            .collect();
+        let mesh = Mesh::new(sphere.positions.clone(), None, upper);
+        let quadrants: Vec<u32> =
+            mesh.positions.iter().map(|p| (p.x > 0.0) as u32 | ((p.y > 0.0) as u32) << 1).collect();
+        let base = cluster_at_t_layer(&mesh, &quadrants, &Rows::neighbours(&mesh.triangles, mesh.positions.len()), 0.0);
+        let r = analyze(&base.mesh);
+        assert_eq!(r.non_manifold_edges, 0, "{r:?}");
+        assert!(r.boundary_edges >= 3, "{r:?}");
+        assert!(base.mesh.positions.len() <= 8, "{} vertices left", base.mesh.positions.len());
     }
 
     #[test]

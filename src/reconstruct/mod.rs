@@ -22,9 +22,11 @@ mod base_mesh;
 mod implicit;
 mod leaf_fit;
 mod refine;
+mod support;
 mod winding;
 
 pub use refine::LevelStats;
+pub use support::Closure;
 
 use crate::distance::{PointBvh, TriangleBvh};
 use crate::error::{shown, Error, Result};
@@ -67,6 +69,15 @@ const OPEN_SCAN_INSIDE: f32 = 0.25;
 /// change the topology. Gaps narrower than twice the offset close, but they are below what the
 /// grid resolves faithfully anyway. Surfaces without handles are never thickened.
 const THICKEN_CELLS: f32 = 1.5;
+/// On an open output, faces farther than this many units (grid cells, or sample spacings
+/// where those are larger) from every sample are trimmed where they reach the border. The
+/// refined surface near the border strays about a cell from the samples (its M0 faces are
+/// coarse there); a tighter cut eats into it and leaves a ragged border.
+const BORDER_TRIM: f32 = 2.0;
+/// The polygonisation grid has at least 2^this cells across the root cube, however coarse the
+/// T-layer: a shape that is a height field over large T-nodes (a hemisphere is one at depth 2)
+/// is otherwise polygonised on a grid too coarse to tell its own shape, or where the samples end.
+const MIN_GRID_DEPTH: u32 = 6;
 /// Ring averages of the fine mesh's normals before its vertices are moved back.
 const NORMAL_SMOOTHING_PASSES: usize = 2;
 /// The polygonisation gives up beyond this many grid cells along the surface.
@@ -97,6 +108,10 @@ pub struct ReconstructParams {
     /// open meshes); 0 keeps the closed surface. Above 0 the input is taken to be open, and
     /// the closing sheet behind it is placed farther back, so that it is trimmed away.
     pub trim: f32,
+    /// Open or closed output: closed by default; `Open` keeps only the part of the surface the
+    /// samples support (an open scan, or a scan's holes kept open); `Auto` decides from how
+    /// much of the closed surface is far from every sample.
+    pub closure: Closure,
     /// Normals: estimated where the cloud has none (PCA over neighbours, oriented by spanning
     /// tree propagation, turned outward); the cloud's own are kept unless
     /// `normals.reorient_given`.
@@ -115,6 +130,7 @@ impl Default for ReconstructParams {
             max_triangles: 20_000_000,
             max_grid_depth: 10,
             trim: 0.0,
+            closure: Closure::Closed,
             normals: NormalParams::default(),
             threads: 0,
         }
@@ -190,6 +206,13 @@ pub struct ReconstructStats {
     /// The polygonisation was thickened (see the `reconstruct` module): the plain one had
     /// handles that vanished once parts thinner than the grid were thickened.
     pub thickened: bool,
+    /// Share of the polygonised closed surface's area farther than the support's reach from
+    /// every sample (about half for a scan from one side).
+    pub unsupported_share: f64,
+    /// The output is the supported part only (see [`Closure`]).
+    pub open: bool,
+    /// Edges of M0 with one face (0 when M0 is closed).
+    pub base_boundary_edges: usize,
     pub base_vertices: usize,
     pub base_triangles: usize,
     /// Genus of M0 when it is a closed manifold.
@@ -303,7 +326,7 @@ pub fn reconstruct(
     let typical_t_half = median(tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| n.half).collect());
     let tolerance = FAR_FROM_SAMPLES * unit;
     let winding = winding::WindingNumber::new(&tree);
-    let inside_above = if params.trim > 0.0 { OPEN_SCAN_INSIDE } else { 0.5 };
+    let inside_above = if params.trim > 0.0 || params.closure == Closure::Open { OPEN_SCAN_INSIDE } else { 0.5 };
     let far = OUTSIDE_BEYOND * unit.max(typical_t_half);
     let f = |p: Vec3| {
         if near.any_within(p, tolerance) {
@@ -358,6 +381,32 @@ pub fn reconstruct(
         move_inward(&mut fine, &neighbours, THICKEN_CELLS * grid.cell, &threads);
     }
     let labels = threads.run(|| base_mesh::label_vertices(&tree, &fine, &neighbours));
+    let sag = plane_sags(&tree, &threads);
+    let reach = support::SUPPORT_REACH * unit;
+    let sample_normals: Vec<Vec3> = tree.samples.iter().map(|s| s.normal).collect();
+    let face_reach = |f: usize| reach + sag.get(labels[fine.triangles[f][0] as usize] as usize).copied().unwrap_or(0.0);
+    let support = support::supported_faces(&fine, &near, &sample_normals, face_reach, &threads);
+    drop((sample_normals, sag));
+    let far: Vec<bool> = support.iter().map(|&s| s == support::Support::Far).collect();
+    let smallest_hole = f64::from(2.0 * typical_t_half).powi(2);
+    stats.unsupported_share =
+        support::unsupported_share(&fine, &support::without_small_regions(&fine, &far, smallest_hole));
+    stats.open = support::is_open(params.closure, stats.unsupported_share) || params.trim > 0.0;
+    let neighbours = if stats.open {
+        // An open M0 is made of the supported part only: the closing sheet never joins a
+        // T-node's cluster.
+        let unsupported: Vec<bool> = support.iter().map(|&s| s != support::Support::Supported).collect();
+        let unsupported = support::without_small_regions(&fine, &unsupported, smallest_hole);
+        let mut u = unsupported.iter();
+        fine.triangles.retain(|_| !*u.next().unwrap_or(&false));
+        // Parts left smaller than the smallest hole are shreds of the closing sheet's edge.
+        let (part, parts) = support::regions(&fine, &vec![true; fine.triangles.len()]);
+        let mut p = part.iter();
+        fine.triangles.retain(|_| p.next().is_some_and(|&r| parts[r as usize].area >= smallest_hole));
+        adjacency::Rows::neighbours(&fine.triangles, fine.positions.len())
+    } else {
+        neighbours
+    };
     let base = base_mesh::cluster_at_t_layer(&fine, &labels, &neighbours, grid.cell);
     drop((fine, labels, neighbours));
     if base.mesh.triangles.is_empty() {
@@ -367,7 +416,8 @@ pub fn reconstruct(
     }
     stats.base_vertices = base.mesh.positions.len();
     stats.base_triangles = base.mesh.triangles.len();
-    stats.base_genus = topology::analyze(&base.mesh).genus();
+    let base_report = topology::analyze(&base.mesh);
+    (stats.base_genus, stats.base_boundary_edges) = (base_report.genus(), base_report.boundary_edges);
     let mut surface = refine::Surface {
         normals: base.labels.iter().map(|&t| tree.frames[tree.nodes[t as usize].frame as usize].normal).collect(),
         positions: base.mesh.positions,
@@ -423,8 +473,14 @@ pub fn reconstruct(
         triangles: surface.triangles,
         origin: cloud.origin,
     };
-    if params.trim > 0.0 {
-        stats.trimmed_triangles = trim_far_faces(&mut mesh, &near, params.trim * grid.cell, &threads);
+    if stats.open {
+        // The polygonisation carries the border past the last samples by up to the support's
+        // reach: faces farther than BORDER_TRIM units go where they reach the border (farther
+        // inside, the surface only strays from sparse or noisy samples, and a hole there would
+        // be wrong). An explicit `trim` removes every face farther than it.
+        let border_reach = BORDER_TRIM * unit;
+        let (limit, anywhere) = if params.trim > 0.0 { (params.trim * grid.cell, true) } else { (border_reach, false) };
+        stats.trimmed_triangles = trim_far_faces(&mut mesh, &near, limit, anywhere, &threads);
     }
     stats.seconds_trim = t3.elapsed().as_secs_f64();
     progress.report(1.0, "done")?;
@@ -444,7 +500,8 @@ fn polygonisation_grid(tree: &VsTree, max_depth: u32, spacing: f32) -> Grid {
         tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| u32::from(n.depth)).max().unwrap_or(0);
     let root = tree.root();
     let resolvable = if spacing > 0.0 { (2.0 * root.half / spacing).log2().floor().max(1.0) as u32 } else { max_depth };
-    let depth = deepest.min(resolvable).clamp(1, max_depth.min(MAX_GRID_POINTS_PER_AXIS.ilog2() - 1));
+    let depth =
+        deepest.max(MIN_GRID_DEPTH).min(resolvable).clamp(1, max_depth.min(MAX_GRID_POINTS_PER_AXIS.ilog2() - 1));
     let cells = 1u32 << depth;
     let cell = 2.0 * root.half / cells as f32;
     let points = cells + 5;
@@ -472,6 +529,23 @@ fn move_inward(mesh: &mut Mesh, neighbours: &adjacency::Rows, distance: f32, thr
         });
     }
     threads.run(|| mesh.positions.par_iter_mut().zip(&normals).for_each(|(p, n)| *p -= distance * *n));
+}
+
+/// Per node, for T-nodes: the largest distance from one of its samples to its plane (0 for
+/// other nodes, and for a label no T-node has).
+fn plane_sags(tree: &VsTree, threads: &Threads) -> Vec<f32> {
+    threads.run(|| {
+        tree.nodes
+            .par_iter()
+            .map(|node| {
+                if node.kind != NodeKind::Transition {
+                    return 0.0;
+                }
+                let frame = &tree.frames[node.frame as usize];
+                tree.samples_of(node).iter().map(|s| frame.height(s.position).abs()).fold(0.0, f32::max)
+            })
+            .collect()
+    })
 }
 
 /// The median of `values` (0 when empty).
@@ -526,18 +600,25 @@ fn sample_error(s: &mut refine::Surface, points: &[Vec3], diagonal: f32, threads
     ((sum_sq / points.len().max(1) as f64).sqrt() / d, max / d)
 }
 
-/// Removes the faces whose centre is farther than `distance` from every sample, then the
+/// Removes the faces whose centre is farther than `distance` from every sample (`anywhere`),
+/// or only those of the connected sets of such faces that reach the mesh's border; then the
 /// vertices no face uses. Returns how many faces went.
-fn trim_far_faces(mesh: &mut Mesh, samples: &PointBvh, distance: f32, threads: &Threads) -> usize {
-    let keep: Vec<bool> = threads.run(|| {
+fn trim_far_faces(mesh: &mut Mesh, samples: &PointBvh, distance: f32, anywhere: bool, threads: &Threads) -> usize {
+    let far: Vec<bool> = threads.run(|| {
         mesh.triangles
             .par_iter()
             .map(|t| {
                 let centre = t.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / 3.0;
-                samples.distance(centre) <= distance
+                !samples.any_within(centre, distance)
             })
             .collect()
     });
+    let keep: Vec<bool> = if anywhere {
+        far.iter().map(|f| !f).collect()
+    } else {
+        let (region, regions) = support::regions(mesh, &far);
+        region.iter().map(|&r| r == u32::MAX || !regions[r as usize].touches_border).collect()
+    };
     let before = mesh.triangles.len();
     let mut k = keep.iter();
     mesh.triangles.retain(|_| *k.next().unwrap_or(&true));

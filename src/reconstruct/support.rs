@@ -1,0 +1,261 @@
+//! Open or closed: which part of the polygonised surface the samples support.
+//!
+//! The implicit function is polygonised as a closed surface. Where the cloud is an open scan,
+//! part of that surface is the sheet that closes the scan behind it, far from every sample.
+//! Measured on the polygonisation, the share of the surface's area that no sample supports
+//! tells an open scan (about half of the closed surface is the closing sheet) from a closed
+//! object whose scan has holes (a few percent), whatever the shape.
+
+use super::adjacency::Rows;
+use crate::distance::PointBvh;
+use crate::mesh::Mesh;
+use crate::progress::Threads;
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// A point of the polygonised surface is supported when a sample lies within this many units
+/// (grid cells, or sample spacings where those are larger). The polygonisation of a sampled
+/// surface stays within one unit of its samples (a grid cell's diagonal is 1.7 cells); two
+/// leave room for noise and sampling gaps, and the bound for open output is two
+/// sample spacings.
+pub(super) const SUPPORT_REACH: f32 = 1.0;
+
+/// A cloud is taken to be open when more than this share of the polygonised surface's area
+/// is far from every sample. A scan from one side leaves 30-60% of the closed surface unsupported; a
+/// closed object scanned all round but with unreachable parts (the bottom it stood on, deep
+/// cavities) leaves a few percent, which are closed over, as Poisson does.
+pub(super) const OPEN_SHARE: f64 = 0.15;
+
+/// Whether the output is open (only the part the samples support) or closed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Closure {
+    /// Open when more than [`OPEN_SHARE`] of the closed surface is far from every sample.
+    /// Not yet the default: the polygonisation of some closed clouds (noisy ones, sparse
+    /// ones that need thickening) has that much surface far from the samples too.
+    Auto,
+    /// Always the closed surface (holes in the scan are closed over).
+    #[default]
+    Closed,
+    /// Always only the supported part (an open scan, or a closed one with its holes kept).
+    Open,
+}
+
+/// A point of the polygonised surface is supported only by samples whose normals are within
+/// this angle's cosine of its own (60 degrees): where an open scan ends, the closed surface
+/// turns back behind it, and the part that has turned by more than that is the closing sheet
+/// even where it passes within reach of the border's samples. Normals perturbed by noise
+/// (20 degrees) stay well inside it.
+pub(super) const SUPPORT_AGREEMENT: f32 = 0.5;
+
+/// How a face of the polygonisation relates to the samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Support {
+    /// No sample within reach.
+    Far,
+    /// Samples within reach, but none whose normal agrees with the face's: the closed
+    /// surface has turned back behind the samples' border.
+    Turned,
+    /// A sample within reach whose normal agrees.
+    Supported,
+}
+
+/// Per face of `mesh`: how the samples of `samples` (normals `normals`, in the same order)
+/// support it, within `reach(face)` of its centre. The face's normal is its corners'
+/// area-weighted normals (the polygonisation's own faces are often slivers).
+pub(super) fn supported_faces(
+    mesh: &Mesh,
+    samples: &PointBvh,
+    normals: &[Vec3],
+    reach: impl Fn(usize) -> f32 + Sync,
+    threads: &Threads,
+) -> Vec<Support> {
+    let vertex_normals = mesh.area_weighted_normals();
+    threads.run(|| {
+        mesh.triangles
+            .par_iter()
+            .enumerate()
+            .map(|(f, t)| {
+                let centre = t.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / 3.0;
+                let n = t.iter().map(|&v| vertex_normals[v as usize]).sum::<Vec3>().normalize_or_zero();
+                if !samples.any_within(centre, reach(f)) {
+                    Support::Far
+                } else if samples.any_within_among(centre, reach(f), |i| normals[i as usize].dot(n) > SUPPORT_AGREEMENT)
+                {
+                    Support::Supported
+                } else {
+                    Support::Turned
+                }
+            })
+            .collect()
+    })
+}
+
+/// The share of `mesh`'s area in the faces that `marked` marks.
+pub(super) fn unsupported_share(mesh: &Mesh, marked: &[bool]) -> f64 {
+    let (mut all, mut part) = (0.0f64, 0.0f64);
+    for (t, &m) in mesh.triangles.iter().zip(marked) {
+        let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+        let area = f64::from((b - a).cross(c - a).length());
+        all += area;
+        if m {
+            part += area;
+        }
+    }
+    if all > 0.0 {
+        part / all
+    } else {
+        0.0
+    }
+}
+
+/// A connected set of marked faces (faces sharing an edge are connected).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct Region {
+    pub area: f64,
+    /// One of its faces has an edge that no other face of the mesh shares.
+    pub touches_border: bool,
+}
+
+/// The regions of the faces `marked` true: per face its region (`u32::MAX` for unmarked
+/// faces), and the regions.
+pub(super) fn regions(mesh: &Mesh, marked: &[bool]) -> (Vec<u32>, Vec<Region>) {
+    let faces = Rows::faces(&mesh.triangles, mesh.positions.len());
+    // The faces other than `f` on edge a-b.
+    let across = |f: usize, a: u32, b: u32| {
+        faces.of(a).iter().copied().filter(move |&g| g as usize != f && mesh.triangles[g as usize].contains(&b))
+    };
+    let mut region = vec![u32::MAX; mesh.triangles.len()];
+    let mut out = Vec::new();
+    let mut stack = Vec::new();
+    for start in 0..mesh.triangles.len() {
+        if !marked[start] || region[start] != u32::MAX {
+            continue;
+        }
+        let id = out.len() as u32;
+        let mut r = Region::default();
+        region[start] = id;
+        stack.push(start);
+        while let Some(f) = stack.pop() {
+            let t = mesh.triangles[f];
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            r.area += 0.5 * f64::from((b - a).cross(c - a).length());
+            for k in 0..3 {
+                let (u, v) = (t[k], t[(k + 1) % 3]);
+                let mut others = across(f, u, v).peekable();
+                r.touches_border |= others.peek().is_none();
+                for g in others {
+                    if marked[g as usize] && region[g as usize] == u32::MAX {
+                        region[g as usize] = id;
+                        stack.push(g as usize);
+                    }
+                }
+            }
+        }
+        out.push(r);
+    }
+    (region, out)
+}
+
+/// `unsupported` with every region of it smaller than `min_area` turned supported: the base
+/// mesh cannot show a hole smaller than its own faces (a T-node), and collapsing keeps every
+/// hole, so a speck of unsupported faces (a sliver whose normal strays, a gap in the samples)
+/// would otherwise become a hole the size of a base-mesh face.
+pub(super) fn without_small_regions(mesh: &Mesh, unsupported: &[bool], min_area: f64) -> Vec<bool> {
+    let (region, regions) = regions(mesh, unsupported);
+    region.iter().map(|&r| r != u32::MAX && regions[r as usize].area >= min_area).collect()
+}
+
+/// Whether the output is open, given the unsupported share of the closed surface.
+pub(super) fn is_open(closure: Closure, unsupported_share: f64) -> bool {
+    match closure {
+        Closure::Auto => unsupported_share > OPEN_SHARE,
+        Closure::Closed => false,
+        Closure::Open => true,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shapes::icosphere;
+
+    #[test]
+    fn a_sphere_sampled_on_one_half_is_half_unsupported() {
+        let sphere = icosphere(1.0, 4);
+        let upper: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z > 0.0).collect();
+        let threads = Threads::new(1).unwrap();
+        let support = supported_faces(&sphere, &PointBvh::new(&upper), &upper, |_| 0.05, &threads);
+        let unsupported: Vec<bool> = support.iter().map(|&s| s == Support::Far).collect();
+        let share = unsupported_share(&sphere, &unsupported);
+        assert!((share - 0.5).abs() < 0.05, "{share}");
+        assert!(is_open(Closure::Auto, share));
+        assert!(!is_open(Closure::Closed, share));
+    }
+
+    #[test]
+    fn a_sphere_with_a_small_hole_stays_closed() {
+        // A cap of 5% of the area unsampled (z > 0.9): a hole, closed over.
+        let sphere = icosphere(1.0, 4);
+        let kept: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z <= 0.9).collect();
+        let threads = Threads::new(1).unwrap();
+        let support = supported_faces(&sphere, &PointBvh::new(&kept), &kept, |_| 0.05, &threads);
+        let unsupported: Vec<bool> = support.iter().map(|&s| s == Support::Far).collect();
+        let share = unsupported_share(&sphere, &unsupported);
+        assert!(share > 0.02 && share < 0.08, "{share}");
+        assert!(!is_open(Closure::Auto, share));
+        assert!(is_open(Closure::Open, share));
+    }
+
+    #[test]
+    fn faces_turned_from_their_samples_are_told_apart() {
+        // The samples of the upper half, with normals pointing down: near, but turned.
+        let sphere = icosphere(1.0, 3);
+        let upper: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z > 0.0).collect();
+        let down: Vec<Vec3> = upper.iter().map(|_| -Vec3::Z).collect();
+        let threads = Threads::new(1).unwrap();
+        let support = supported_faces(&sphere, &PointBvh::new(&upper), &down, |_| 0.2, &threads);
+        let centre = |t: &[u32; 3]| t.iter().map(|&v| sphere.positions[v as usize]).sum::<Vec3>() / 3.0;
+        for (t, s) in sphere.triangles.iter().zip(&support) {
+            let z = centre(t).z;
+            if z > 0.1 {
+                assert_eq!(*s, Support::Turned, "z {z}");
+            } else if z < -0.25 {
+                assert_eq!(*s, Support::Far, "z {z}");
+            }
+        }
+    }
+
+    #[test]
+    fn specks_smaller_than_the_bound_are_closed_over() {
+        // Two unsupported regions: a cap of 5% of the area and one face elsewhere.
+        let sphere = icosphere(1.0, 4);
+        let centre = |t: &[u32; 3]| t.iter().map(|&v| sphere.positions[v as usize]).sum::<Vec3>() / 3.0;
+        let speck = sphere.triangles.iter().position(|t| centre(t).z < -0.9).unwrap();
+        let unsupported: Vec<bool> =
+            sphere.triangles.iter().enumerate().map(|(f, t)| centre(t).z > 0.9 || f == speck).collect();
+        let (_, regions) = regions(&sphere, &unsupported);
+        assert_eq!(regions.len(), 2);
+        assert!(regions.iter().all(|r| !r.touches_border), "a closed mesh has no border");
+        let kept = without_small_regions(&sphere, &unsupported, 0.1);
+        assert!(!kept[speck]);
+        assert_eq!(kept.iter().filter(|&&k| k).count(), unsupported.iter().filter(|&&u| u).count() - 1);
+    }
+
+    #[test]
+    fn regions_see_the_border() {
+        let sphere = icosphere(1.0, 3);
+        let upper: Vec<[u32; 3]> = sphere
+            .triangles
+            .iter()
+            .copied()
+            .filter(|t| t.iter().all(|&v| sphere.positions[v as usize].z > -1e-6))
+            .collect();
+        let dome = Mesh::new(sphere.positions.clone(), None, upper);
+        let near_pole: Vec<bool> =
+            dome.triangles.iter().map(|t| t.iter().all(|&v| dome.positions[v as usize].z > 0.8)).collect();
+        let near_rim: Vec<bool> =
+            dome.triangles.iter().map(|t| t.iter().any(|&v| dome.positions[v as usize].z < 0.1)).collect();
+        assert!(!regions(&dome, &near_pole).1[0].touches_border);
+        assert!(regions(&dome, &near_rim).1.iter().all(|r| r.touches_border));
+    }
+}
