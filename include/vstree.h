@@ -110,6 +110,21 @@
 #define VSTREE_ORIENTATION_PROPAGATE_OUTWARD 3
 
 /**
+ * `closure` value: open when more than 15% of the closed surface is far from every point.
+ */
+#define VSTREE_CLOSURE_AUTO 0
+
+/**
+ * `closure` value: always the closed surface, holes and the back of an open scan closed over.
+ */
+#define VSTREE_CLOSURE_CLOSED 1
+
+/**
+ * `closure` value: only the part of the surface the points support (open where they end).
+ */
+#define VSTREE_CLOSURE_OPEN 2
+
+/**
  * `stopped` value: error(M, S) reached `target_distance`.
  */
 #define VSTREE_REFINEMENT_STOPPED_TARGET 0
@@ -905,6 +920,17 @@ typedef struct vstree_reconstruct_params {
    * Worker threads: 0 = all cores (default), else at most 1024. Results do not depend on it.
    */
   uint32_t threads;
+  /**
+   * Open or closed output, a VSTREE_CLOSURE_* value. Default VSTREE_CLOSURE_AUTO: open
+   * where much of the closed surface would be far from every point (a scan from one side),
+   * closed otherwise (small holes in a scan are closed over). Since 0.1.3.
+   */
+  int32_t closure;
+  /**
+   * Must be 0 (keeps the struct free of padding; a later version may give it a meaning).
+   * Since 0.1.3.
+   */
+  uint32_t reserved;
 } vstree_reconstruct_params;
 
 /**
@@ -1029,6 +1055,20 @@ typedef struct vstree_reconstruct_stats {
    * polygonisation had handles and the thickened one fewer), else 0. Since 0.1.1.
    */
   uint32_t thickened;
+  /**
+   * 1 when the output is open (only the part of the surface the points support), else 0.
+   * Since 0.1.3.
+   */
+  uint32_t open;
+  /**
+   * Edges of the base mesh M0 with one face (0 when M0 is closed). Since 0.1.3.
+   */
+  uint32_t base_boundary_edges;
+  /**
+   * Share of the closed polygonised surface's area far from every point (about half for a
+   * scan from one side); `closure` AUTO makes the output open above 0.15. Since 0.1.3.
+   */
+  double unsupported_share;
 } vstree_reconstruct_stats;
 
 #ifdef __cplusplus

@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use vstree::reconstruct::{reconstruct, ReconstructParams, ReconstructStats, RefinementStop};
+use vstree::reconstruct::{reconstruct, Closure, ReconstructParams, ReconstructStats, RefinementStop};
 use vstree::simplify::{simplify, SimplifyParams, SimplifyStats};
 use vstree::tree::{Metric, TreeKind, TreeParams, TreeStats};
 use vstree::{io, MeshSampling, Progress, SampleSet, Threads};
@@ -69,11 +69,20 @@ enum Command {
         /// Most refinement levels (each one multiplies the triangles by 4).
         #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().max_levels)]
         levels: u32,
-        /// Remove faces farther than this many grid cells from every sample, so an open scan
-        /// gives an open mesh (0 = keep the closed surface). Use it for single range scans:
-        /// above 0 the surface that closes the scan is put well behind it, where it is trimmed.
+        /// Remove every face farther than this many grid cells from every sample, and make the
+        /// output open (0 = no such trimming: open scans are found and cut at their border
+        /// without it).
         #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().trim)]
         trim: f32,
+        /// Keep only the part of the surface that the samples support: for a scan from one
+        /// side (the output's border follows the scan's), or to keep a scan's holes open. By
+        /// default the surface is closed, over holes and the back of an open scan.
+        #[arg(long, conflicts_with = "detect_open")]
+        open: bool,
+        /// Make the output open only when much of the closed surface would be far from every
+        /// sample (experimental: some noisy or sparse closed clouds come out open).
+        #[arg(long)]
+        detect_open: bool,
         /// Re-orient the normals the cloud already has (consistent by spanning-tree
         /// propagation, then facing outward). Clouds without normals always get them estimated.
         #[arg(long)]
@@ -312,7 +321,19 @@ fn run(command: Command) -> vstree::Result<()> {
             }
             Ok(())
         }
-        Command::Reconstruct { input, output, tree, target, levels, trim, reorient, neighbours, ascii } => {
+        Command::Reconstruct {
+            input,
+            output,
+            tree,
+            target,
+            levels,
+            trim,
+            open,
+            detect_open,
+            reorient,
+            neighbours,
+            ascii,
+        } => {
             let normals = vstree::normals::NormalParams { neighbours, reorient_given: reorient, ..Default::default() };
             let params = ReconstructParams {
                 normals,
@@ -320,6 +341,11 @@ fn run(command: Command) -> vstree::Result<()> {
                 target_distance: target,
                 max_levels: levels,
                 trim,
+                closure: match (open, detect_open) {
+                    (true, _) => Closure::Open,
+                    (_, true) => Closure::Auto,
+                    _ => Closure::Closed,
+                },
                 threads: tree.threads,
                 ..ReconstructParams::default()
             };
@@ -461,10 +487,18 @@ fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &Reconstruct
     };
     println!("refinement stopped: {stopped}");
     println!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
+    let share = 100.0 * s.unsupported_share;
+    if s.open {
+        println!("open: {share:.0}% of the closed surface is far from the samples; kept: the part they support");
+    } else {
+        println!(
+            "closed: {share:.0}% of the closed surface is far from the samples, closed over (--open keeps it open)"
+        );
+    }
     if s.final_error > FAR_FROM_SAMPLES {
         eprintln!(
             "warning: the surface is far from the samples (RMS {:.1}% of the diagonal) and does not \
-             represent this cloud (open scans, such as a single view, are not yet reconstructed open)",
+             represent this cloud",
             100.0 * s.final_error
         );
     }

@@ -3,11 +3,11 @@
 
 use super::mesh::{into_handle, mesh_ref, vstree_mesh};
 use super::normals::{flag, orientation, orientation_value, threads};
-use super::params::{self, Versioned};
+use super::params::{self, one_of, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
-use super::{guard, guard_or, non_null, vstree_status, write_out, FfiResult};
+use super::{guard, guard_or, non_null, vstree_status, write_out, Failure, FfiResult};
 use crate::normals::NormalParams;
-use crate::reconstruct::{reconstruct, ReconstructParams, ReconstructStats, RefinementStop};
+use crate::reconstruct::{reconstruct, Closure, ReconstructParams, ReconstructStats, RefinementStop};
 use crate::tree::{Metric, TreeKind, TreeParams};
 use std::ffi::c_void;
 use std::mem::size_of;
@@ -70,6 +70,48 @@ pub struct vstree_reconstruct_params {
     pub reorient_given: u32,
     /// Worker threads: 0 = all cores (default), else at most 1024. Results do not depend on it.
     pub threads: u32,
+    /// Open or closed output, a VSTREE_CLOSURE_* value. Default VSTREE_CLOSURE_CLOSED; use
+    /// VSTREE_CLOSURE_OPEN for a scan from one side (only the part of the surface the points
+    /// support is kept). Since 0.1.3.
+    pub closure: i32,
+    /// Must be 0 (keeps the struct free of padding; a later version may give it a meaning).
+    /// Since 0.1.3.
+    pub reserved: u32,
+}
+
+/// `closure` value: open when more than 15% of the closed surface is far from every point.
+/// Experimental: some noisy or sparse closed clouds come out open.
+pub const VSTREE_CLOSURE_AUTO: i32 = 0;
+/// `closure` value: always the closed surface, holes and the back of an open scan closed over.
+pub const VSTREE_CLOSURE_CLOSED: i32 = 1;
+/// `closure` value: only the part of the surface the points support (open where they end).
+pub const VSTREE_CLOSURE_OPEN: i32 = 2;
+
+/// Reads a `closure` field.
+fn closure(value: i32) -> FfiResult<Closure> {
+    let value = one_of(
+        "closure",
+        value,
+        &[
+            (VSTREE_CLOSURE_AUTO, "VSTREE_CLOSURE_AUTO"),
+            (VSTREE_CLOSURE_CLOSED, "VSTREE_CLOSURE_CLOSED"),
+            (VSTREE_CLOSURE_OPEN, "VSTREE_CLOSURE_OPEN"),
+        ],
+    )?;
+    Ok(match value {
+        VSTREE_CLOSURE_CLOSED => Closure::Closed,
+        VSTREE_CLOSURE_OPEN => Closure::Open,
+        _ => Closure::Auto,
+    })
+}
+
+/// The C value of a closure.
+fn closure_value(closure: Closure) -> i32 {
+    match closure {
+        Closure::Auto => VSTREE_CLOSURE_AUTO,
+        Closure::Closed => VSTREE_CLOSURE_CLOSED,
+        Closure::Open => VSTREE_CLOSURE_OPEN,
+    }
 }
 
 unsafe impl Versioned for vstree_reconstruct_params {
@@ -94,6 +136,8 @@ unsafe impl Versioned for vstree_reconstruct_params {
             neighbours: d.normals.neighbours as u32,
             reorient_given: u32::from(d.normals.reorient_given),
             threads: 0,
+            closure: closure_value(d.closure),
+            reserved: 0,
         }
     }
 }
@@ -118,6 +162,9 @@ pub(crate) unsafe fn read_reconstruct_params(
         threads,
     };
     normals.check()?;
+    if p.reserved != 0 {
+        return Err(Failure::parameter("reserved", format!("{}: must be 0", p.reserved)));
+    }
     let params = ReconstructParams {
         tree: TreeParams {
             kind: TreeKind::VsTree,
@@ -134,6 +181,7 @@ pub(crate) unsafe fn read_reconstruct_params(
         max_triangles: p.max_triangles as usize,
         max_grid_depth: p.max_grid_depth,
         trim: p.trim,
+        closure: closure(p.closure)?,
         normals,
         threads,
     };
@@ -205,6 +253,14 @@ pub struct vstree_reconstruct_stats {
     /// 1 when the base mesh was polygonised with thin parts thickened (the plain
     /// polygonisation had handles and the thickened one fewer), else 0. Since 0.1.1.
     pub thickened: u32,
+    /// 1 when the output is open (only the part of the surface the points support), else 0.
+    /// Since 0.1.3.
+    pub open: u32,
+    /// Edges of the base mesh M0 with one face (0 when M0 is closed). Since 0.1.3.
+    pub base_boundary_edges: u32,
+    /// Share of the closed polygonised surface's area far from every point (about half for a
+    /// scan from one side); `closure` AUTO makes the output open above 0.15. Since 0.1.3.
+    pub unsupported_share: f64,
 }
 
 /// `stopped` value: error(M, S) reached `target_distance`.
@@ -259,6 +315,9 @@ pub(crate) fn stats_of(s: &ReconstructStats, input_points: usize, seconds_total:
         seconds_total,
         stopped: stopped_value(s.stopped),
         thickened: u32::from(s.thickened),
+        open: u32::from(s.open),
+        base_boundary_edges: u32::try_from(s.base_boundary_edges).unwrap_or(u32::MAX),
+        unsupported_share: s.unsupported_share,
     }
 }
 
@@ -375,13 +434,15 @@ mod tests {
 
     #[test]
     fn layouts_have_no_padding() {
-        assert_eq!(size_of::<vstree_reconstruct_params>(), 80);
         assert_eq!(offset_of!(vstree_reconstruct_params, error), 8);
         assert_eq!(offset_of!(vstree_reconstruct_params, min_cell_size), 32);
         assert_eq!(offset_of!(vstree_reconstruct_params, max_triangles), 56);
         assert_eq!(offset_of!(vstree_reconstruct_params, threads), 76);
-        assert_eq!(size_of::<vstree_reconstruct_stats>(), 24 + 21 * 8 + 8);
+        assert_eq!(size_of::<vstree_reconstruct_stats>(), 24 + 21 * 8 + 8 + 16);
+        assert_eq!(offset_of!(vstree_reconstruct_params, closure), 80);
+        assert_eq!(size_of::<vstree_reconstruct_params>(), 88);
         assert_eq!(offset_of!(vstree_reconstruct_stats, stopped), 24 + 21 * 8);
+        assert_eq!(offset_of!(vstree_reconstruct_stats, unsupported_share), 24 + 21 * 8 + 16);
     }
 
     #[test]
@@ -395,7 +456,7 @@ mod tests {
     #[test]
     fn every_field_is_checked_by_name() {
         type Spoil = fn(&mut vstree_reconstruct_params);
-        let cases: [(&str, Spoil); 17] = [
+        let cases: [(&str, Spoil); 19] = [
             ("orient", |p| p.orient = 4),
             ("error", |p| p.error = 0.0),
             ("error", |p| p.error = f64::NAN),
@@ -413,6 +474,8 @@ mod tests {
             ("neighbours", |p| p.neighbours = 1000),
             ("reorient_given", |p| p.reorient_given = 7),
             ("threads", |p| p.threads = u32::MAX),
+            ("closure", |p| p.closure = 3),
+            ("reserved", |p| p.reserved = 1),
         ];
         for (field, spoil) in cases {
             let mut p = vstree_reconstruct_params_default();

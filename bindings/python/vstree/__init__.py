@@ -331,7 +331,14 @@ _TREE_KINDS = {"vstree": 0, "octree": 1}
 _METRICS = {"l2": 0, "l21": 1, "density": 2}
 _SAMPLINGS = {"vertices": 0, "faces": 1, "face_centers": 1}
 _ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
-_ENUMS = {"tree_kind": _TREE_KINDS, "metric": _METRICS, "sampling": _SAMPLINGS, "orient": _ORIENTATIONS}
+_CLOSURES = {"auto": 0, "closed": 1, "open": 2}
+_ENUMS = {
+    "tree_kind": _TREE_KINDS,
+    "metric": _METRICS,
+    "sampling": _SAMPLINGS,
+    "orient": _ORIENTATIONS,
+    "closure": _CLOSURES,
+}
 _C_INTEGERS = {ctypes.c_uint32: ("uint32", 0, 2**32 - 1), ctypes.c_int32: ("int32", -(2**31), 2**31 - 1)}
 
 
@@ -549,6 +556,7 @@ _RECONSTRUCT_FIELDS = (
     "neighbours",
     "reorient_given",
     "threads",
+    "closure",
 )
 _NORMAL_FIELDS = ("orient", "neighbours", "reorient_given", "threads")
 
@@ -570,13 +578,15 @@ NormalsResult.__doc__ = "A :class:`Mesh` with normals, and a dict saying what wa
 
 
 def reconstruct(cloud, normals=None, progress=None, **params):
-    """Reconstructs a closed triangle mesh from a point cloud: ``cloud`` is a :class:`Mesh`
+    """Reconstructs a triangle mesh from a point cloud: ``cloud`` is a :class:`Mesh`
     (its triangles are ignored) or an (n, 3) array of points, with ``normals`` optional (n, 3);
     missing normals are estimated and oriented outward. Parameters are the C struct's fields:
     ``error`` (the tree's L2 bound, the de-noising control; default 1e-5), ``max_levels``
     (refinement levels, 0-12; default 6), ``target_distance``, ``min_displaced``,
-    ``max_triangles``, ``max_grid_depth`` (4-20; default 10), ``trim`` (grid cells; 0 keeps the
-    closed surface), ``d_a``, ``d_d``, ``max_depth``, ``min_cell_size``, ``orient``
+    ``max_triangles``, ``max_grid_depth`` (4-20; default 10), ``closure`` ("auto", the default:
+    open where much of the closed surface is far from every point, as for a scan from one
+    side, | "closed" | "open"), ``trim`` (grid cells: every face farther goes; 0, the default,
+    trims only past an open scan's border), ``d_a``, ``d_d``, ``max_depth``, ``min_cell_size``, ``orient``
     ("propagate_outward" | "propagate" | "propagate_majority" | "unoriented"), ``neighbours``,
     ``reorient_given``, ``threads``.
 
@@ -600,6 +610,7 @@ def reconstruct(cloud, normals=None, progress=None, **params):
         stats = _struct_dict(stats)
         stats["stopped"] = _ffi.REFINEMENT_STOPPED.get(stats["stopped"], "unknown")
         stats["thickened"] = bool(stats["thickened"])
+        stats["open"] = bool(stats["open"])
     except BaseException:
         lib.vstree_reconstruct_result_free(result)
         raise

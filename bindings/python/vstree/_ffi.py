@@ -212,6 +212,8 @@ class ReconstructParams(Structure):
         ("neighbours", c_uint32),
         ("reorient_given", c_uint32),
         ("threads", c_uint32),
+        ("closure", c_int32),
+        ("reserved", c_uint32),
     ]
 
 
@@ -246,6 +248,9 @@ class ReconstructStats(Structure):
         ("seconds_total", c_double),
         ("stopped", c_uint32),
         ("thickened", c_uint32),
+        ("open", c_uint32),
+        ("base_boundary_edges", c_uint32),
+        ("unsupported_share", c_double),
     ]
 
 
