@@ -5,7 +5,7 @@ mod common;
 
 use glam::Vec3;
 use vstree::distance::chamfer_and_hausdorff;
-use vstree::reconstruct::{reconstruct, ReconstructParams, ReconstructStats, RefinementStop};
+use vstree::reconstruct::{reconstruct, Closure, ReconstructParams, ReconstructStats, RefinementStop};
 use vstree::tree::TreeParams;
 use vstree::{shapes, topology, Error, Mesh, Progress};
 
@@ -172,21 +172,119 @@ fn same_mesh_with_one_or_two_threads() {
 #[test]
 fn a_single_range_scan_gives_an_open_mesh() {
     let Some(scan) = common::load("bunny_raw_bun000.ply") else { return };
-    let (mesh, stats) = run(&scan, &ReconstructParams { trim: 3.0, ..Default::default() });
+    // Found to be open, and made open.
+    let (mesh, stats) = run(&scan, &ReconstructParams { closure: Closure::Auto, ..Default::default() });
     let report = topology::analyze(&mesh);
     eprintln!(
-        "bun000: {} triangles after trimming {}; {} boundary edges",
+        "bun000: {:.0}% of the closed surface unsupported; {} triangles, {} boundary edges",
+        100.0 * stats.unsupported_share,
         mesh.triangles.len(),
-        stats.trimmed_triangles,
         report.boundary_edges
     );
-    assert!(report.boundary_edges > 0, "a single scan must stay open");
-    // The scan closed by a sheet well behind it: one blob without handles, whose back goes.
-    assert_eq!(stats.base_genus, Some(0), "M0 of a single scan");
-    assert!(stats.trimmed_triangles > 500, "{} trimmed", stats.trimmed_triangles);
+    assert!(stats.open && stats.unsupported_share > 0.3, "{}", stats.unsupported_share);
+    assert!(report.boundary_edges > 0 && report.non_manifold_edges == 0, "{report:?}");
+    // No hole inside the scan: the border is short (a closing sheet clustered into M0, or
+    // specks of it, would leave thousands of border edges).
+    assert!(report.boundary_edges < mesh.triangles.len() / 20, "{report:?}");
     // What is left is near the samples.
     let far = vstree::distance::one_sided(&mesh.positions, vstree::distance::Target::Points(&scan.positions));
-    assert!(far.p99 < 0.02 * scan.bounds().unwrap().diagonal(), "p99 {}", far.p99);
+    assert!(far.p99 < 0.01 * scan.bounds().unwrap().diagonal(), "p99 {}", far.p99);
+    // By default, the same scan gives a closed surface.
+    let (mesh, stats) = run(&scan, &ReconstructParams::default());
+    assert!(!stats.open && topology::analyze(&mesh).is_watertight());
+}
+
+/// `count` points on the unit sphere where `keep` holds, with their exact normals.
+fn sphere_points(count: usize, keep: impl Fn(Vec3) -> bool) -> Mesh {
+    let sphere = shapes::icosphere(1.0, 5);
+    let kept =
+        sphere.triangles.iter().copied().filter(|t| t.iter().all(|&v| keep(sphere.positions[v as usize]))).collect();
+    let cloud = shapes::sample_surface(&Mesh::new(sphere.positions.clone(), None, kept), count, 11);
+    let on_sphere: Vec<Vec3> = cloud.positions.iter().map(|p| p.normalize()).collect();
+    Mesh::from_points(on_sphere.clone(), Some(on_sphere))
+}
+
+/// The median distance from a point to its nearest other point.
+fn spacing(points: &[Vec3]) -> f32 {
+    let bvh = vstree::distance::PointBvh::new(points);
+    let mut gaps: Vec<f32> = (0..points.len())
+        .step_by(7)
+        .filter_map(|i| bvh.nearest_among(points[i], |j| j as usize != i).map(|(d, _)| d))
+        .collect();
+    gaps.sort_by(f32::total_cmp);
+    gaps[gaps.len() / 2]
+}
+
+#[test]
+fn a_hemisphere_gives_an_open_dome_up_to_its_rim() {
+    for count in [10_000, 100_000] {
+        let cloud = sphere_points(count, |p| p.z > -1e-6);
+        let (mesh, stats) = run(&cloud, &ReconstructParams { closure: Closure::Auto, ..Default::default() });
+        let report = topology::analyze(&mesh);
+        assert!(stats.open, "{count}: {:.2} unsupported", stats.unsupported_share);
+        assert!(report.boundary_edges > 0 && report.non_manifold_edges == 0 && report.components == 1, "{report:?}");
+        // On the sphere, and reaching the rim all round: every border vertex near z = 0. (The
+        // refinement's bumps of a few hundredths, at the pole and the rim, are a known defect:
+        // 0.061 at 10k points.)
+        let off = mesh.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max);
+        assert!(off < 0.07, "{count}: a vertex {off} off the sphere");
+        assert!(stats.final_error < 1e-3, "{count}: RMS {}", stats.final_error);
+        let h = spacing(&cloud.positions);
+        let border_heights: Vec<f32> = border_vertices(&mesh).iter().map(|&v| mesh.positions[v].z).collect();
+        let highest = border_heights.iter().copied().fold(f32::MIN, f32::max);
+        let lowest = border_heights.iter().copied().fold(f32::MAX, f32::min);
+        // Measured: from -3.4 to +2.5 spacings at 10k points (the border overshoots by up to a
+        // grid cell, and is trimmed back as much where the refined surface strays).
+        // Below the rim the overshoot is up to about a grid cell (the grid spans the cloud's
+        // width of 2 in `grid_cells` cells; at 100k points it is 8 spacings).
+        let cell = 2.0 / stats.grid_cells as f32;
+        assert!(
+            highest < 3.0 * h && lowest > -(2.0 * cell).max(4.0 * h),
+            "{count}: border from z = {lowest} to {highest}, spacing {h}, cell {cell}"
+        );
+    }
+}
+
+/// The vertices on an edge that only one face has.
+fn border_vertices(mesh: &Mesh) -> Vec<usize> {
+    let mut edges: Vec<(u32, u32)> = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    let mut out: Vec<usize> = edges
+        .chunk_by(|a, b| a == b)
+        .filter(|run| run.len() == 1)
+        .flat_map(|run| [run[0].0 as usize, run[0].1 as usize])
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+#[test]
+fn a_sphere_with_a_small_hole_stays_closed_unless_asked() {
+    // A cap of 5% of the area unsampled: closed over by default and by `Auto`, kept open with
+    // `Open`.
+    let cloud = sphere_points(40_000, |p| p.z < 0.9);
+    let auto = run(&cloud, &ReconstructParams { closure: Closure::Auto, ..Default::default() }).1;
+    assert!(!auto.open, "{:.3} unsupported", auto.unsupported_share);
+    let (mesh, stats) = run(&cloud, &ReconstructParams::default());
+    assert!(!stats.open);
+    let report = topology::analyze(&mesh);
+    assert!(report.is_watertight() && report.genus() == Some(0), "{report:?}");
+    let (mesh, stats) = run(&cloud, &ReconstructParams { closure: Closure::Open, ..Default::default() });
+    let report = topology::analyze(&mesh);
+    assert!(stats.open && report.boundary_edges > 0 && report.non_manifold_edges == 0, "{report:?}");
+    // The hole shrinks by the reach of the samples around it (the T-nodes' sag): measured
+    // open above z = 0.986 where the samples stop at 0.9.
+    let top = mesh.positions.iter().map(|p| p.z).fold(f32::MIN, f32::max);
+    assert!(top < 0.99, "the hole was covered up to z = {top}");
+    // A hemisphere is closed by default.
+    let dome = sphere_points(10_000, |p| p.z > -1e-6);
+    let (mesh, stats) = run(&dome, &ReconstructParams::default());
+    assert!(!stats.open && topology::analyze(&mesh).is_watertight());
 }
 
 #[test]

@@ -60,8 +60,6 @@ pub const OPEN_PEERS: [&str; 2] = ["open3d-poisson8-trim", "open3d-poisson10-tri
 const HEMISPHERES: [usize; 2] = [10_000, 200_000];
 const SYNTHETIC: usize = 200_000;
 const QUICK_POINTS: usize = 20_000;
-/// vstree's trimming on open inputs, in grid cells (as `tests/reconstruct.rs` uses on a scan).
-pub const TRIM_CELLS: f32 = 3.0;
 
 /// Command-line options.
 pub struct Options {
@@ -394,11 +392,7 @@ impl Bench<'_> {
             self.start.elapsed().as_secs_f64()
         );
         let open = case.truth.open;
-        let params = ReconstructParams {
-            trim: if open { TRIM_CELLS } else { 0.0 },
-            threads: self.o.threads,
-            ..ReconstructParams::default()
-        };
+        let params = ReconstructParams { threads: self.o.threads, ..ReconstructParams::default() };
         let local_cloud = inputs::local(&case.cloud, case.offset);
         let samples = open.then(|| Samples::new(&local_cloud.positions));
         let stem = case.stem();
@@ -409,12 +403,15 @@ impl Bench<'_> {
                 }
                 let q = quality(&inputs::local(&rec.mesh, case.offset), case.truth, samples.as_ref());
                 eprintln!(
-                    "corpus:   vstree {:.2} s, {} vertices, genus {:?} (truth {:?}), Chamfer {:.4}%",
+                    "corpus:   vstree {:.2} s, {} vertices, genus {:?} (truth {:?}), Chamfer {:.4}%, {} ({:.1}% unsupported), farthest face {:.1} spacings",
                     rec.seconds.total,
                     q.vertices,
                     q.genus,
                     case.truth.genus,
-                    100.0 * q.distances.chamfer().unwrap_or(f64::NAN)
+                    100.0 * q.distances.chamfer().unwrap_or(f64::NAN),
+                    if rec.stats.open { "open" } else { "closed" },
+                    100.0 * rec.stats.unsupported_share,
+                    q.farthest_face.unwrap_or(f64::NAN)
                 );
                 Ok((rec.seconds, rec.stats.levels.len(), q))
             }

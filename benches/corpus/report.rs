@@ -7,7 +7,7 @@ use crate::common::report::{header, percent, relative, thousands};
 use crate::common::stats::median;
 use crate::inputs::{Variant, TRUTH_SAMPLES};
 use crate::measure::{Quality, FOLD_DEGREES};
-use crate::{CLOSED_PEERS, OPEN_PEERS, TRIM_CELLS};
+use crate::{CLOSED_PEERS, OPEN_PEERS};
 use std::fmt::Write as _;
 
 /// One input: vstree's reconstruction and the peers'.
@@ -184,7 +184,7 @@ impl Report {
         };
         let _ = writeln!(
             md,
-            "- vstree: `ReconstructParams::default()`, `trim` = {TRIM_CELLS} grid cells on open inputs; threads: \
+            "- vstree: `ReconstructParams::default()` on every input (open or closed is found, not told); threads: \
              {threads}; {} timed run{} per input.{peers}",
             c.runs,
             if c.runs == 1 { "" } else { "s" }
