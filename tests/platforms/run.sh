@@ -54,6 +54,9 @@ same_as_header() { # $1 platform, stdin: exported names
     echo "   $1: exports the header's $(echo "$exported" | wc -l) vstree_* functions and nothing else"
 }
 
+echo "-- clippy for windows-x64 (the code behind cfg(not(unix)))"
+cargo clippy --quiet --locked --lib --no-default-features --target x86_64-pc-windows-gnu -- -D warnings
+
 echo "-- linux-x64: glibc 2.28"
 so=target/x86_64-unknown-linux-gnu/release/libvstree.so
 file -L "$so" | grep -q "ELF 64-bit LSB shared object, x86-64" || fail "$so: $(file -L "$so")"
@@ -90,11 +93,9 @@ for platform in macos-arm64 macos-x64; do
     # Apple Silicon runs only signed code; the linker signs ad hoc.
     [ "$cpu" != arm64 ] || echo "$headers" | grep -q "cmd LC_CODE_SIGNATURE" || fail "$dylib: not signed"
     used=$(llvm-objdump --macho --dylibs-used "$dylib" | tail -n +3 | awk '{print $1}' | tr '\n' ' ')
-    case $used in
-        *" "/usr/lib/libiconv.2.dylib" "/usr/lib/libSystem.B.dylib" "*) ;;
-        *) fail "$dylib: links $used, not only macOS's libSystem and libiconv" ;;
-    esac
-    echo "   macOS $VSTREE_MACOS_DEPLOYMENT_TARGET+, install name @rpath/libvstree.dylib, links ${used#* }"
+    [ "$used" = "/usr/lib/libiconv.2.dylib /usr/lib/libSystem.B.dylib " ] \
+        || fail "$dylib: links $used, not only macOS's libSystem and libiconv"
+    echo "   macOS $VSTREE_MACOS_DEPLOYMENT_TARGET+, install name @rpath/libvstree.dylib, links $used"
 done
 
 echo "-- zips: one per platform, each with its own library"
@@ -118,7 +119,7 @@ mkdir -p "$build/tmp/dir.ply" "$build/bad-input"
 cp "$dll" "$build/"
 warn="-Wall -Wextra -Werror -pedantic"
 cargo_version=$(sed -n 's/^version = "\([^"]*\)"$/\1/p' Cargo.toml | head -n 1)
-link=(-Iinclude -L"$(dirname "$dll")" -lvstree)
+link=(-Iinclude -Ibindings/cpp -L"$(dirname "$dll")" -lvstree)
 x86_64-w64-mingw32-gcc -std=c99 $warn -DEXPECTED_VERSION="\"$cargo_version\"" tests/c/test_api.c "${link[@]}" -lm \
     -o "$build/test_api.exe"
 # winpthreads linked in, so the program needs no DLL beside vstree.dll and the system's.
@@ -134,8 +135,10 @@ x86_64-w64-mingw32-gcc -shared -O2 $warn tests/platforms/wine_bcryptprimitives.c
 export WINEPREFIX=${VSTREE_WINEPREFIX:-${XDG_CACHE_HOME:-$HOME/.cache}/vstree/wine64}
 export WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml=" WINEARCH=win64
 wine=$(command -v wine64 || echo /usr/lib/wine/wine64)
-wineserver=$(command -v wineserver || echo /usr/lib/wine/wineserver64)
-"$wineserver" -p 60  # one server for every run (ends 60 s after the last client)
+if [ ! -f "$WINEPREFIX/system.reg" ]; then
+    mkdir -p "$WINEPREFIX"
+    "$wine" wineboot --init </dev/null >/dev/null 2>&1 || true
+fi
 winpath() { echo "Z:${1//\//\\}"; }
 win() { # runs a test program under Wine; its output goes to stdout, the status is returned
     (cd "$build" && "$wine" "$@" </dev/null 2>&1 | tr -d '\r')
