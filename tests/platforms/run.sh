@@ -2,8 +2,8 @@
 # Every platform of the Blender extension, built by plugins/blender/build.sh and checked:
 #   linux-x64    needs no GLIBC symbol newer than 2.28; exports exactly the header's functions
 #   windows-x64  a PE DLL exporting exactly the header's functions; the C API tests
-#                (tests/c: test_api, test_threads, test_cpp, the example) cross-compiled with
-#                mingw-w64 and run under Wine
+#                (tests/c: test_api, test_bad_input, test_threads, test_cpp, the example)
+#                cross-compiled with mingw-w64 and run under Wine
 #   macos-*      Mach-O dylibs of the right CPU, exporting exactly the header's functions,
 #                macOS 11 minimum, install name @rpath/libvstree.dylib
 #   zips         one per platform, validated by blender_ext.py, with only that platform's
@@ -122,6 +122,7 @@ cargo_version=$(sed -n 's/^version = "\([^"]*\)"$/\1/p' Cargo.toml | head -n 1)
 link=(-Iinclude -Ibindings/cpp -L"$(dirname "$dll")" -lvstree)
 x86_64-w64-mingw32-gcc -std=c99 $warn -DEXPECTED_VERSION="\"$cargo_version\"" tests/c/test_api.c "${link[@]}" -lm \
     -o "$build/test_api.exe"
+x86_64-w64-mingw32-gcc -std=c99 $warn tests/c/test_bad_input.c "${link[@]}" -lm -o "$build/test_bad_input.exe"
 # winpthreads linked in, so the program needs no DLL beside vstree.dll and the system's.
 x86_64-w64-mingw32-gcc -std=c99 $warn -pthread tests/c/test_threads.c "${link[@]}" -lm \
     -Wl,-Bstatic -lpthread -Wl,-Bdynamic -o "$build/test_threads.exe"
@@ -146,6 +147,9 @@ win() { # runs a test program under Wine; its output goes to stdout, the status 
 }
 output=$(win ./test_api.exe "$(winpath "$build/tmp")") || { echo "$output" >&2; fail "test_api.exe failed under Wine"; }
 echo "$output" | tail -n 1
+output=$(win ./test_bad_input.exe "$(winpath "$build/bad-input")") \
+    || { echo "$output" >&2; fail "test_bad_input.exe failed under Wine"; }
+echo "$output" | tail -n 1
 output=$(win ./test_threads.exe) || { echo "$output" >&2; fail "test_threads.exe failed under Wine"; }
 echo "$output" | tail -n 1
 output=$(win ./test_cpp.exe "$(winpath "$build/tmp")") || { echo "$output" >&2; fail "test_cpp.exe failed under Wine"; }
@@ -158,5 +162,5 @@ if output=$(win ./example.exe "$(winpath "$build/tmp/missing.ply")" "$(winpath "
     fail "example.exe should fail on a missing file"
 fi
 echo "$output" | grep -q "missing.ply" || fail "example.exe's error does not name the file: $output"
-echo "   Wine $("$wine" --version 2>/dev/null | tr -d '\r'): 4 programs passed in $(($(date +%s) - start)) s"
+echo "   Wine $("$wine" --version 2>/dev/null | tr -d '\r'): 5 programs passed in $(($(date +%s) - start)) s"
 echo "tests/platforms: every platform built and checked"
