@@ -131,7 +131,7 @@ build_library() {
                 --config 'profile.release.strip="symbols"' >&2  # mingw keeps a symbol table, 2 MB
             ;;
         macos-*)
-            local sdk=$PWD/target/macos-sdk-stub
+            local sdk=$PWD/target/macos-sdk-stub-zig$ZIGLANG_VERSION
             [ -f "$sdk/usr/lib/libSystem.tbd" ] || macos_sdk_stub "$sdk"
             SDKROOT=$sdk MACOSX_DEPLOYMENT_TARGET=$VSTREE_MACOS_DEPLOYMENT_TARGET \
                 cargo build "${cargo_args[@]}" --target "$target" \
