@@ -44,5 +44,8 @@ bash fuzz/run.sh 10
 echo "== MeshLab plugin in pymeshlab 2022.2.post4 and 2025.7.post1"
 bash tests/meshlab/run.sh
 
+echo "== Blender extension for every platform: linux-x64 (glibc 2.28), windows-x64 (C API tests under Wine), macos-arm64, macos-x64"
+bash tests/platforms/run.sh
+
 echo "== Blender extension in bpy 4.2.23 and 5.0.1"
 bash tests/blender/run.sh

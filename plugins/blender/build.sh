@@ -1,8 +1,18 @@
 #!/usr/bin/env bash
-# Builds the VS-Tree Blender extension zip:
-#   target/blender/dist/vstree-0.1.2-linux_x64.zip
-# Stages plugins/blender/vstree_blender + bindings/python/vstree + libvstree.so under
-# target/blender/stage/vstree, then runs Blender's own blender_ext.py build.
+# Builds the VS-Tree Blender extension, one zip per platform Blender's extension platform
+# serves, into target/blender/dist:
+#   vstree-<version>-linux_x64.zip     libvstree.so, glibc 2.28 and later (as Blender's builds)
+#   vstree-<version>-windows_x64.zip   vstree.dll (x86_64-pc-windows-gnu, mingw-w64)
+#   vstree-<version>-macos_arm64.zip   libvstree.dylib, Apple Silicon, macOS 11 and later
+#   vstree-<version>-macos_x64.zip     libvstree.dylib, Intel, macOS 11 and later
+# Each platform is staged under target/blender/stage/<platform>/ (the add-on, the ctypes
+# binding, that platform's library, the manifest with `platforms = [<platform>]`), built with
+# Blender's own `blender_ext.py build --split-platforms` and checked with `blender_ext.py
+# validate`. VSTREE_PLATFORMS="linux-x64 ..." builds only those (default: all four).
+#
+# The cross toolchain (pinned versions) is described in plugins/blender/toolchain.sh;
+# VSTREE_INSTALL_TOOLS=1 installs what is missing (Debian packages, rustup targets, a Python
+# environment under ~/.cache), else a missing tool stops the build with its name.
 #
 # blender_ext.py ships inside Blender (and the PyPI bpy wheel); give its path with
 # BLENDER_EXT_PY, else it is looked for in the test venvs under target/ (tests/blender/run.sh
@@ -10,9 +20,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 root=$PWD
+# shellcheck source=plugins/blender/toolchain.sh
+source plugins/blender/toolchain.sh
 
-cargo build --release --locked --lib --no-default-features
-lib=$root/target/release/libvstree.so
+platforms=${VSTREE_PLATFORMS:-$VSTREE_PLATFORMS_ALL}
+for p in $platforms; do rust_target "$p" >/dev/null; done
+[ "${VSTREE_INSTALL_TOOLS:-0}" = 1 ] && toolchain_install
+# shellcheck disable=SC2086
+toolchain_check $platforms
 
 ext_py=${BLENDER_EXT_PY:-}
 if [ -z "$ext_py" ]; then
@@ -24,15 +39,24 @@ if [ -z "$ext_py" ] || [ ! -f "$ext_py" ]; then
 fi
 python=${PYTHON:-python3}
 
-stage=$root/target/blender/stage/vstree
+manifest=plugins/blender/vstree_blender/blender_manifest.toml
+version=$(sed -n 's/^version = "\([^"]*\)"$/\1/p' "$manifest")
 dist=$root/target/blender/dist
-rm -rf "$stage" "$dist"
-mkdir -p "$stage" "$dist"     # blender_ext.py does not create the output directory
-cp plugins/blender/vstree_blender/*.py plugins/blender/vstree_blender/blender_manifest.toml "$stage/"
-mkdir -p "$stage/vstree"
-cp bindings/python/vstree/*.py "$stage/vstree/"
-cp "$lib" "$stage/vstree/libvstree.so"
+mkdir -p "$dist"     # blender_ext.py does not create the output directory
 
-"$python" "$ext_py" build --source-dir "$stage" --output-dir "$dist" --split-platforms
-"$python" "$ext_py" validate "$dist"/vstree-0.1.2-linux_x64.zip
-echo "built $dist/vstree-0.1.2-linux_x64.zip"
+for platform in $platforms; do
+    lib=$(build_library "$platform")
+    stage=$root/target/blender/stage/$platform/vstree
+    zip=$dist/vstree-$version-${platform/-/_}.zip
+    rm -rf "$stage" "$zip"
+    mkdir -p "$stage/vstree"
+    cp plugins/blender/vstree_blender/*.py "$stage/"
+    # This zip's manifest names its one platform: Blender refuses it on the others.
+    sed "s/^platforms = .*/platforms = [\"$platform\"]/" "$manifest" >"$stage/blender_manifest.toml"
+    grep -qx "platforms = \[\"$platform\"\]" "$stage/blender_manifest.toml"
+    cp bindings/python/vstree/*.py "$stage/vstree/"
+    cp "$lib" "$stage/vstree/$(library_name "$platform")"
+    "$python" "$ext_py" build --source-dir "$stage" --output-dir "$dist" --split-platforms >/dev/null
+    "$python" "$ext_py" validate "$zip"
+    echo "built $zip ($(du -k "$zip" | cut -f1) KiB)"
+done

@@ -94,7 +94,7 @@ echo "-- a program linked against target/release runs from there (libvstree.so.$
 cc -std=c99 $warn -Iinclude bindings/c/example.c -Ltarget/release -lvstree -o "$build/example-local"
 LD_LIBRARY_PATH="$PWD/target/release" "$build/example-local" "$tmp/out.ply" "$tmp/example-local.obj" 5e-3 \
     2>"$tmp/example-local.log" || { cat "$tmp/example-local.log" >&2; exit 1; }
-LD_LIBRARY_PATH="$PWD/target/release" ldd "$build/example-local" | grep -q "libvstree.so.$abi => $PWD/target/release/libvstree.so.$abi"
+LD_LIBRARY_PATH="$PWD/target/release" ldd "$build/example-local" | grep "libvstree.so.$abi => $PWD/target/release/libvstree.so.$abi" >/dev/null
 
 echo "-- find_package(vstree) from CMake"
 cmake -S tests/c/cmake -B "$build/cmake" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null

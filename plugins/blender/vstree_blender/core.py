@@ -7,6 +7,8 @@ the scene is only written after the library call returned.
 """
 
 import importlib
+import os
+import platform
 
 import bpy
 import numpy as np
@@ -31,10 +33,81 @@ def binding():
         except (ImportError, OSError) as e:
             _BINDING_ERROR = str(e)
             raise VstreeUnavailable(
-                "VS-Tree native library unavailable: %s. Reinstall the extension built for "
-                "this platform (linux-x64)." % e
+                "VS-Tree native library unavailable: %s. Details: %s" % (what_to_install(), e)
             ) from None
     return _BINDING
+
+
+# ---- platforms -----------------------------------------------------------------------------
+
+#: The library file of each platform, as plugins/blender/build.sh puts it in each zip.
+LIBRARY_NAMES = {"linux": "libvstree.so", "windows": "vstree.dll", "macos": "libvstree.dylib"}
+
+
+def this_platform():
+    """Blender's name for the platform this Blender runs on (``linux-x64``, ``windows-x64``,
+    ``macos-arm64``, ``macos-x64``...), as its extension platform tags zips."""
+    system = {"darwin": "macos"}.get(platform.system().lower(), platform.system().lower())
+    machine = platform.machine().lower()
+    machine = {"x86_64": "x64", "amd64": "x64", "aarch64": "arm64"}.get(machine, machine)
+    return "%s-%s" % (system, machine)
+
+
+def library_platform(path):
+    """The platform a shared library was built for, read from its header (ELF, PE or
+    Mach-O), or None when the file is none of those."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(64)
+            if head[:4] == b"\x7fELF" and len(head) >= 20:
+                machine = int.from_bytes(head[18:20], "big" if head[5] == 2 else "little")
+                return "linux-" + {0x3E: "x64", 0xB7: "arm64"}.get(machine, "0x%x" % machine)
+            if head[:2] == b"MZ" and len(head) >= 64:
+                f.seek(int.from_bytes(head[60:64], "little"))
+                pe = f.read(6)
+                if pe[:4] == b"PE\0\0":
+                    machine = int.from_bytes(pe[4:6], "little")
+                    return "windows-" + {0x8664: "x64", 0xAA64: "arm64"}.get(machine, "0x%x" % machine)
+            if head[:4] == b"\xcf\xfa\xed\xfe" and len(head) >= 8:
+                cpu = int.from_bytes(head[4:8], "little")
+                return "macos-" + {0x01000007: "x64", 0x0100000C: "arm64"}.get(cpu, "0x%x" % cpu)
+    except OSError:
+        pass
+    return None
+
+
+def _zip_name(platform_name):
+    """The name plugins/blender/build.sh gives this version's zip for ``platform_name``."""
+    try:
+        import tomllib
+
+        with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "blender_manifest.toml"), "rb") as f:
+            version = tomllib.load(f)["version"]
+    except (OSError, ValueError, KeyError, ImportError):
+        version = "<version>"
+    return "vstree-%s-%s.zip" % (version, platform_name.replace("-", "_"))
+
+
+def what_to_install(directory=None):
+    """What the user should install, for the message of a library that did not load: names the
+    platform the installed library was built for, when it is another one, and the zip for this
+    platform."""
+    directory = directory or os.path.join(os.path.dirname(os.path.abspath(__file__)), "vstree")
+    here = this_platform()
+    want = "Install %s (Edit > Preferences > Get Extensions > Install from Disk)" % _zip_name(here)
+    if here not in ("linux-x64", "windows-x64", "macos-arm64", "macos-x64"):
+        return "VS-Tree is built for linux-x64, windows-x64, macos-arm64 and macos-x64, not for %s" % here
+    found = []
+    for name in sorted(set(LIBRARY_NAMES.values())):
+        path = os.path.join(directory, name)
+        if os.path.exists(path):
+            found.append((name, library_platform(path)))
+    others = [(name, p) for name, p in found if p != here]
+    if others and len(others) == len(found):
+        name, p = others[0]
+        return "This installation holds %s for %s, but Blender runs on %s. %s" % (
+            name, p or "an unknown platform", here, want)
+    return "Reinstall the extension built for this platform (%s). %s" % (here, want)
 
 
 def status():
