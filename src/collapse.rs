@@ -164,17 +164,26 @@ impl Collapser {
 
     /// Merges `u` into `v` if the edge exists and the link condition holds.
     fn try_collapse(&mut self, u: u32, v: u32) -> bool {
-        if !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
+        let ok = self.can_collapse(u, v);
+        if ok {
+            self.merge(u, v);
+        }
+        ok
+    }
+
+    /// Whether merging `u` into `v` keeps the topology: both alive, the edge shared by exactly
+    /// two faces, not an interior edge between border vertices, the link condition, and no
+    /// closed component shrunk below a tetrahedron.
+    pub(crate) fn can_collapse(&mut self, u: u32, v: u32) -> bool {
+        if u == v || !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
             return false;
         }
-        let mut shared = [0u32; 2];
         let mut shared_count = 0;
         for f in self.faces(u) {
             if self.triangles[f as usize].contains(&v) {
                 if shared_count == 2 {
                     return false; // more than two faces on the edge: not a manifold edge
                 }
-                shared[shared_count] = f;
                 shared_count += 1;
             }
         }
@@ -186,11 +195,53 @@ impl Collapser {
         }
         let (ring_u, ring_v, common) = self.rings_and_common(u, v);
         // Link condition; and never shrink a closed component below a tetrahedron.
-        if common != 2 || ring_u + ring_v <= 6 {
+        common == 2 && ring_u + ring_v > 6
+    }
+
+    /// Whether merging border vertex `u` into border vertex `v` along their border edge (one
+    /// face) keeps the border manifold: the link condition with the border coned to a virtual
+    /// vertex, i.e. the face's third vertex `w` is the only neighbour they share, and `w` is
+    /// not joined to both by border edges (a border loop of three edges, which would shrink
+    /// to two).
+    pub(crate) fn can_collapse_border(&mut self, u: u32, v: u32) -> bool {
+        if u == v || !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
             return false;
         }
-        for &f in &shared {
-            self.alive_face[f as usize] = false;
+        let mut shared = None;
+        for f in self.faces(u) {
+            if self.triangles[f as usize].contains(&v) {
+                if shared.is_some() {
+                    return false; // an interior edge
+                }
+                shared = Some(f);
+            }
+        }
+        let Some(f) = shared else { return false };
+        let t = self.triangles[f as usize];
+        let w = t.into_iter().find(|&x| x != u && x != v).unwrap_or(u);
+        if self.border[w as usize] && self.edge_faces(u, w) == 1 && self.edge_faces(v, w) == 1 {
+            return false;
+        }
+        let (_, _, common) = self.rings_and_common(u, v);
+        common == 1
+    }
+
+    /// The live faces on edge u-v.
+    pub(crate) fn edge_faces(&self, u: u32, v: u32) -> usize {
+        self.faces(u).filter(|&f| self.triangles[f as usize].contains(&v)).count()
+    }
+
+    /// Merges `u` into `v` along their edge, which [`Collapser::can_collapse`] (or
+    /// [`Collapser::can_collapse_border`]) has accepted: the edge's faces die, `u`'s faces move
+    /// to `v`.
+    pub(crate) fn merge(&mut self, u: u32, v: u32) {
+        let mut c = self.head[u as usize];
+        while c != NO_CORNER {
+            let f = (c / 3) as usize;
+            if self.alive_face[f] && self.triangles[f].contains(&v) {
+                self.alive_face[f] = false;
+            }
+            c = self.next[c as usize];
         }
         // v's new list: its own live corners, then u's, now v's.
         let mut list = NO_CORNER;
@@ -214,7 +265,21 @@ impl Collapser {
         let (sum, count) = (self.sum[u as usize], self.count[u as usize]);
         self.sum[v as usize] += sum;
         self.count[v as usize] += count;
-        true
+    }
+
+    /// Whether `v` is alive (not merged into another vertex, not removed).
+    pub(crate) fn is_alive(&self, v: u32) -> bool {
+        self.alive_vertex[v as usize]
+    }
+
+    /// Whether `v` is on a border (or has absorbed a border vertex).
+    pub(crate) fn is_border(&self, v: u32) -> bool {
+        self.border[v as usize]
+    }
+
+    /// The live faces around `v`, as vertex triples.
+    pub(crate) fn faces_around(&self, v: u32) -> impl Iterator<Item = [u32; 3]> + '_ {
+        self.faces(v).map(|f| self.triangles[f as usize])
     }
 
     /// The mesh of the surviving vertices, each at the mean of the vertices it absorbed, and
