@@ -140,7 +140,8 @@ impl Decimator {
 
     /// Queues the best collapse of edge u-v, if one is allowed: a border vertex stays where
     /// it is (so borders keep their shape), along a border the cheaper end stays; otherwise
-    /// the merged quadric's minimiser or either end, whichever costs least.
+    /// the merged quadric's minimiser (the middle where it has none) or either end, whichever
+    /// costs least (Garland & Heckbert's choice).
     fn plan(&mut self, u: u32, v: u32) {
         let (bu, bv) = (self.collapser.is_border(u), self.collapser.is_border(v));
         let border = bu && bv;
@@ -161,7 +162,8 @@ impl Decimator {
         } else if bv {
             (u, v, pv)
         } else {
-            let x = q.quadric_minimizer();
+            // Where the quadric pins no single point (flat or creased), the middle or an end.
+            let x = q.quadric_minimizer_if_regular().unwrap_or(0.5 * (pu + pv));
             let best = [x, pu, pv].into_iter().min_by(|a, b| q.quadric_at(*a).total_cmp(&q.quadric_at(*b)));
             (u.max(v), u.min(v), best.unwrap_or(x))
         };
