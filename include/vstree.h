@@ -70,12 +70,12 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 1
+#define VSTREE_VERSION_MINOR 2
 
 /**
  * Patch version (semver).
  */
-#define VSTREE_VERSION_PATCH 2
+#define VSTREE_VERSION_PATCH 0
 
 /**
  * The ABI version: the number in the shared library's SONAME (`libvstree.so.0`). It changes
