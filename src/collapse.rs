@@ -272,6 +272,11 @@ impl Collapser {
         self.alive_vertex[v as usize]
     }
 
+    /// Whether any vertex is on a border.
+    pub(crate) fn has_border(&self) -> bool {
+        self.border.iter().any(|&b| b)
+    }
+
     /// Whether `v` is on a border (or has absorbed a border vertex).
     pub(crate) fn is_border(&self, v: u32) -> bool {
         self.border[v as usize]

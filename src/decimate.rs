@@ -175,6 +175,9 @@ impl Decimator {
     /// face, weighted like one vertex's samples (the mean count of samples per vertex), so a
     /// border that moves costs as much as a surface that does.
     fn add_border_planes(&mut self, mesh: &Mesh) {
+        if !self.collapser.has_border() {
+            return; // closed: nothing to sort out
+        }
         let n = self.quadrics.len().max(1) as f64;
         let weight = self.quadrics.iter().map(|q| q.count as f64).sum::<f64>() / n;
         let mut edges: Vec<((u32, u32), u32)> = Vec::new();
