@@ -265,7 +265,8 @@ const CLUSTER_MARGIN: f64 = 1.05;
 
 /// The L2 bound (relative, squared) a sized run builds its tree at before growing it to the
 /// target by largest error: coarse, so the parallel build does the top levels and small targets
-/// need no cut of a deep tree; any start gives the same result (tree::fit's tests).
+/// need no cut of a deep tree; any start gives the same result up to ties between equal errors
+/// (tree::fit's tests).
 const SEED_ERROR: f64 = 1e-2;
 
 /// At most this many rounds of regrowing the tree when the clustering still gives too few
@@ -298,7 +299,7 @@ fn simplify_to_size(
     let t0 = Instant::now();
     let samples = SampleSet::from_mesh(mesh, params.sampling)?;
     let t1 = Instant::now();
-    // The tree is grown or cut from here; the result does not depend on where it starts.
+    // The tree is grown or cut from here; where it starts matters only for ties.
     let seed = match params.tree.metric {
         tree::Metric::L2 => TreeParams { error: params.tree.error.max(SEED_ERROR), ..params.tree },
         _ => params.tree,

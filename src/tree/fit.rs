@@ -2,8 +2,9 @@
 //! node with the largest error (the metric the tree was built with) is replaced by its children
 //! until there are enough leaves. Nodes the tree already has are reused; leaves are split as
 //! [`build`](super::build) would split them, so the result does not depend on the bound the
-//! tree was built with, only on the number of leaves asked for. Nodes below the new leaves are
-//! dropped. This is how a simplification reaches a triangle count inside one tree, without
+//! tree was built with, only on the number of leaves asked for, except where nodes have equal
+//! errors (flat CAD faces have zero error): ties go to the lower node index, and indices
+//! depend on how the tree was built. Nodes below the new leaves are dropped. This is how a simplification reaches a triangle count inside one tree, without
 //! rebuilding it for trial bounds.
 
 use super::build::{sum, Builder, Part, Pending};
