@@ -70,12 +70,12 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 1
+#define VSTREE_VERSION_MINOR 2
 
 /**
  * Patch version (semver).
  */
-#define VSTREE_VERSION_PATCH 2
+#define VSTREE_VERSION_PATCH 0
 
 /**
  * The ABI version: the number in the shared library's SONAME (`libvstree.so.0`). It changes
@@ -111,6 +111,7 @@
 
 /**
  * `closure` value: open when more than 15% of the closed surface is far from every point.
+ * Experimental: some noisy or sparse closed clouds come out open.
  */
 #define VSTREE_CLOSURE_AUTO 0
 
@@ -347,6 +348,35 @@ typedef int32_t vstree_label_kind;
 #endif // __cplusplus
 
 /**
+ * Whether vstree_simplify() keeps the input's topology (the `keep_topology` field).
+ */
+enum vstree_keep_topology
+#ifdef __cplusplus
+  : int32_t
+#endif // __cplusplus
+ {
+  /**
+   * Keep it when the input is a closed 2-manifold (no border, no non-manifold edge or
+   * vertex, consistently oriented); plain clustering otherwise. The default.
+   */
+  VSTREE_KEEP_TOPOLOGY_AUTO = 0,
+  /**
+   * Clusters merge by edge collapses under the link condition: a closed 2-manifold stays
+   * closed and manifold with its genus, an open one keeps its borders manifold. A cluster
+   * that cannot merge without changing the topology keeps a vertex per piece.
+   */
+  VSTREE_KEEP_TOPOLOGY_ON = 1,
+  /**
+   * Plain vertex clustering (the paper's): faster, but it may fuse sheets and make
+   * non-manifold edges.
+   */
+  VSTREE_KEEP_TOPOLOGY_OFF = 2,
+};
+#ifndef __cplusplus
+typedef int32_t vstree_keep_topology;
+#endif // __cplusplus
+
+/**
  * An immutable triangle mesh or point cloud (a mesh with no triangles), with optional
  * per-vertex normals. Opaque: made by vstree_mesh_create(), vstree_mesh_load() or
  * vstree_mesh_load_memory(), freed with vstree_mesh_free(). Results own meshes too
@@ -432,6 +462,22 @@ typedef struct vstree_simplify_params {
    * against duplicate points). In [0, 1); default 1e-7.
    */
   double min_cell_size;
+  /**
+   * A vstree_keep_topology value. Default VSTREE_KEEP_TOPOLOGY_AUTO. Since 0.2.0 (callers
+   * built against an older header get the default).
+   */
+  int32_t keep_topology;
+  /**
+   * Triangles wanted, from 1 to the input's count; 0 (the default) = as many as `error`
+   * gives. With a target, `error` is no bound: the tree is grown or cut, splitting the
+   * cluster with the largest error first, to about half as many clusters as triangles
+   * wanted, and quadric edge collapses (under the same topology rules) bring the mesh to
+   * the target, within one triangle. A target below what the topology allows (a closed
+   * surface of genus g needs more than 4 g triangles; a tetrahedron, 4, is the least) gives
+   * the smallest mesh the collapses reach: compare the stats' `output_triangles`. Meshes
+   * only; ignored by vstree_tree_build(). Since 0.2.0.
+   */
+  uint32_t target_faces;
 } vstree_simplify_params;
 
 /**
@@ -531,6 +577,14 @@ typedef struct vstree_simplify_stats {
    * Seconds in the whole library call, from parameter check to result.
    */
   double seconds_total;
+  /**
+   * 1 when the topology was kept (see vstree_keep_topology), else 0. Since 0.2.0.
+   */
+  uint32_t kept_topology;
+  /**
+   * The `target_faces` asked for (0: the error bound was used). Since 0.2.0.
+   */
+  uint32_t target_faces;
 } vstree_simplify_stats;
 
 /**
@@ -921,14 +975,14 @@ typedef struct vstree_reconstruct_params {
    */
   uint32_t threads;
   /**
-   * Open or closed output, a VSTREE_CLOSURE_* value. Default VSTREE_CLOSURE_AUTO: open
-   * where much of the closed surface would be far from every point (a scan from one side),
-   * closed otherwise (small holes in a scan are closed over). Since 0.1.3.
+   * Open or closed output, a VSTREE_CLOSURE_* value. Default VSTREE_CLOSURE_CLOSED; use
+   * VSTREE_CLOSURE_OPEN for a scan from one side (only the part of the surface the points
+   * support is kept). Since 0.2.0.
    */
   int32_t closure;
   /**
    * Must be 0 (keeps the struct free of padding; a later version may give it a meaning).
-   * Since 0.1.3.
+   * Since 0.2.0.
    */
   uint32_t reserved;
 } vstree_reconstruct_params;
@@ -1057,16 +1111,16 @@ typedef struct vstree_reconstruct_stats {
   uint32_t thickened;
   /**
    * 1 when the output is open (only the part of the surface the points support), else 0.
-   * Since 0.1.3.
+   * Since 0.2.0.
    */
   uint32_t open;
   /**
-   * Edges of the base mesh M0 with one face (0 when M0 is closed). Since 0.1.3.
+   * Edges of the base mesh M0 with one face (0 when M0 is closed). Since 0.2.0.
    */
   uint32_t base_boundary_edges;
   /**
    * Share of the closed polygonised surface's area far from every point (about half for a
-   * scan from one side); `closure` AUTO makes the output open above 0.15. Since 0.1.3.
+   * scan from one side); `closure` AUTO makes the output open above 0.15. Since 0.2.0.
    */
   double unsupported_share;
 } vstree_reconstruct_stats;

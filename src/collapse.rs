@@ -4,7 +4,7 @@
 //! topology of a 2-manifold, so the result keeps the input's genus and stays closed where it
 //! was closed; where the link condition blocks the last collapses of a cluster (a cluster
 //! wrapped around a handle), the cluster keeps a few vertices. On an open mesh, border edges
-//! collapse along the border under the same condition (the border closed by a dummy vertex);
+//! collapse along the border under the same condition (the border coned to a dummy vertex);
 //! interior edges joining two border vertices never collapse (that would pinch the border).
 //! Used for the reconstruction's base mesh and for simplification that keeps topology.
 
@@ -75,12 +75,15 @@ impl Collapser {
     /// Collapses every edge whose ends share a label, while the link condition allows. In
     /// rounds, each vertex in at most one collapse per round (a greedy matching), so clusters
     /// shrink evenly and rings stay small; merging everything into one growing vertex instead
-    /// makes every link test cost the cluster's whole perimeter. Border edges go first: a
-    /// cluster's stretch of border shrinks to one vertex before its inside merges into it, or
-    /// else an inside vertex merged into two border vertices leaves an edge between them
-    /// across the inside, which no collapse may then take (it would pinch the border).
+    /// makes every link test cost the cluster's whole perimeter. On an open mesh, border edges
+    /// go first: a cluster's stretch of border shrinks to one vertex before its inside merges
+    /// into it, or else an inside vertex merged into two border vertices leaves an edge
+    /// between them across the inside, which no collapse may then take (it would pinch the
+    /// border).
     pub(crate) fn collapse_within(&mut self, labels: &[u32]) {
-        self.collapse_rounds(labels, true);
+        if self.has_border() {
+            self.collapse_rounds(labels, true);
+        }
         self.collapse_rounds(labels, false);
     }
 
@@ -91,8 +94,7 @@ impl Collapser {
             .filter(|&t| self.alive_face[t as usize] && same_label(&self.triangles[t as usize]))
             .collect();
         if border_only {
-            candidates
-                .retain(|&t| self.triangles[t as usize].iter().filter(|&&v| self.border[v as usize]).count() >= 2);
+            candidates.retain(|&t| self.triangles[t as usize].iter().filter(|&&v| self.border[v as usize]).count() >= 2);
         }
         let mut touched = vec![false; self.alive_vertex.len()];
         loop {
@@ -122,6 +124,26 @@ impl Collapser {
             }
             candidates.retain(|&t| self.alive_face[t as usize] && same_label(&self.triangles[t as usize]));
         }
+    }
+
+    /// Where `u` and `v` are border vertices joined by an inside edge, one of whose faces is
+    /// an ear (its third corner has no other face: the border runs u, tip, v), takes the ear
+    /// off: the border then runs along u-v, which can collapse. A disk stays a disk. The tip
+    /// is of another label (or its border edge to `u` or `v` would have collapsed), and the
+    /// ear is what keeps `u` and `v`'s stretch of border from shrinking to one vertex.
+    fn cut_ear(&mut self, u: u32, v: u32) -> bool {
+        if !self.border[u as usize] || !self.border[v as usize] {
+            return false;
+        }
+        let ear = self.faces(u).find(|&f| {
+            let t = self.triangles[f as usize];
+            t.contains(&v) && t.iter().any(|&w| w != u && w != v && self.faces(w).count() == 1)
+        });
+        let Some(f) = ear else { return false };
+        let tip = self.triangles[f as usize].into_iter().find(|&w| w != u && w != v).unwrap_or(u);
+        self.alive_face[f as usize] = false;
+        self.alive_vertex[tip as usize] = false;
+        true
     }
 
     /// The corners around `v`, dead faces' included.
@@ -177,62 +199,86 @@ impl Collapser {
         (ring_u, ring_v, common)
     }
 
-    /// Where `u` and `v` are border vertices joined by an inside edge, one of whose faces is
-    /// an ear (its third corner has no other face: the border runs u, tip, v), takes the ear
-    /// off: the border then runs along u-v, which can collapse. A disk stays a disk. The tip
-    /// is of another label (or its border edge to `u` or `v` would have collapsed), and the
-    /// ear is what keeps `u` and `v`'s stretch of border from shrinking to one vertex.
-    fn cut_ear(&mut self, u: u32, v: u32) -> bool {
-        if !self.border[u as usize] || !self.border[v as usize] {
-            return false;
-        }
-        let ear = self.faces(u).find(|&f| {
-            let t = self.triangles[f as usize];
-            t.contains(&v) && t.iter().any(|&w| w != u && w != v && self.faces(w).count() == 1)
-        });
-        let Some(f) = ear else { return false };
-        let tip = self.triangles[f as usize].into_iter().find(|&w| w != u && w != v).unwrap_or(u);
-        self.alive_face[f as usize] = false;
-        self.alive_vertex[tip as usize] = false;
-        true
-    }
-
     /// Merges `u` into `v` if the edge exists and the link condition holds.
     fn try_collapse(&mut self, u: u32, v: u32) -> bool {
-        if !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
+        let ok = if self.edge_faces(u, v) == 1 { self.can_collapse_border(u, v) } else { self.can_collapse(u, v) };
+        if ok {
+            self.merge(u, v);
+        }
+        ok
+    }
+
+    /// Whether merging `u` into `v` keeps the topology: both alive, the edge shared by exactly
+    /// two faces, not an interior edge between border vertices, the link condition, and no
+    /// closed component shrunk below a tetrahedron.
+    pub(crate) fn can_collapse(&mut self, u: u32, v: u32) -> bool {
+        if u == v || !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
             return false;
         }
-        let mut shared = [0u32; 2];
         let mut shared_count = 0;
         for f in self.faces(u) {
             if self.triangles[f as usize].contains(&v) {
                 if shared_count == 2 {
                     return false; // more than two faces on the edge: not a manifold edge
                 }
-                shared[shared_count] = f;
                 shared_count += 1;
             }
         }
-        let on_border = match shared_count {
-            // A border edge. Its ends are border vertices by definition.
-            1 => true,
-            2 if self.border[u as usize] && self.border[v as usize] => {
-                return false; // an interior edge between two border vertices: would pinch the border
-            }
-            2 => false,
-            _ => return false, // no edge at all
-        };
+        if shared_count != 2 {
+            return false; // a border or non-manifold edge (or no edge at all)
+        }
+        if self.border[u as usize] && self.border[v as usize] {
+            return false; // an interior edge between two border vertices: would pinch the border
+        }
         let (ring_u, ring_v, common) = self.rings_and_common(u, v);
-        // Link condition: the common neighbours are the corners opposite the edge (one on a
-        // border edge: seen with a dummy vertex closing the border, the other is the dummy).
-        // And never shrink a closed component below a tetrahedron, an open one below two
-        // triangles.
-        let (corners, smallest) = if on_border { (1, 4) } else { (2, 6) };
-        if common != corners || ring_u + ring_v <= smallest {
+        // Link condition; and never shrink a closed component below a tetrahedron.
+        common == 2 && ring_u + ring_v > 6
+    }
+
+    /// Whether merging border vertex `u` into border vertex `v` along their border edge (one
+    /// face) keeps the border manifold: the link condition with the border coned to a virtual
+    /// vertex, i.e. the face's third vertex `w` is the only neighbour they share, and `w` is
+    /// not joined to both by border edges (a border loop of three edges, which would shrink
+    /// to two).
+    pub(crate) fn can_collapse_border(&mut self, u: u32, v: u32) -> bool {
+        if u == v || !self.alive_vertex[u as usize] || !self.alive_vertex[v as usize] {
             return false;
         }
-        for &f in &shared[..shared_count] {
-            self.alive_face[f as usize] = false;
+        let mut shared = None;
+        for f in self.faces(u) {
+            if self.triangles[f as usize].contains(&v) {
+                if shared.is_some() {
+                    return false; // an interior edge
+                }
+                shared = Some(f);
+            }
+        }
+        let Some(f) = shared else { return false };
+        let t = self.triangles[f as usize];
+        let w = t.into_iter().find(|&x| x != u && x != v).unwrap_or(u);
+        if self.border[w as usize] && self.edge_faces(u, w) == 1 && self.edge_faces(v, w) == 1 {
+            return false;
+        }
+        let (_, _, common) = self.rings_and_common(u, v);
+        common == 1
+    }
+
+    /// The live faces on edge u-v.
+    pub(crate) fn edge_faces(&self, u: u32, v: u32) -> usize {
+        self.faces(u).filter(|&f| self.triangles[f as usize].contains(&v)).count()
+    }
+
+    /// Merges `u` into `v` along their edge, which [`Collapser::can_collapse`] (or
+    /// [`Collapser::can_collapse_border`]) has accepted: the edge's faces die, `u`'s faces move
+    /// to `v`.
+    pub(crate) fn merge(&mut self, u: u32, v: u32) {
+        let mut c = self.head[u as usize];
+        while c != NO_CORNER {
+            let f = (c / 3) as usize;
+            if self.alive_face[f] && self.triangles[f].contains(&v) {
+                self.alive_face[f] = false;
+            }
+            c = self.next[c as usize];
         }
         // v's new list: its own live corners, then u's, now v's.
         let mut list = NO_CORNER;
@@ -265,7 +311,26 @@ impl Collapser {
             }
         }
         self.border[v] |= self.border[u];
-        true
+    }
+
+    /// Whether `v` is alive (not merged into another vertex, not removed).
+    pub(crate) fn is_alive(&self, v: u32) -> bool {
+        self.alive_vertex[v as usize]
+    }
+
+    /// Whether any vertex is on a border.
+    pub(crate) fn has_border(&self) -> bool {
+        self.border.iter().any(|&b| b)
+    }
+
+    /// Whether `v` is on a border (or has absorbed a border vertex).
+    pub(crate) fn is_border(&self, v: u32) -> bool {
+        self.border[v as usize]
+    }
+
+    /// The live faces around `v`, as vertex triples.
+    pub(crate) fn faces_around(&self, v: u32) -> impl Iterator<Item = [u32; 3]> + '_ {
+        self.faces(v).map(|f| self.triangles[f as usize])
     }
 
     /// The mesh of the surviving vertices, each at the mean of the vertices it absorbed, and

@@ -6,6 +6,7 @@
 //! clustering simplification, and drives a fast point-to-mesh reconstruction.
 
 mod collapse;
+mod decimate;
 pub mod distance;
 pub mod error;
 pub mod ffi;
@@ -29,5 +30,5 @@ pub use error::{Error, Result};
 pub use mesh::{Aabb, Mesh};
 pub use progress::{Progress, Threads};
 pub use samples::{MeshSampling, SampleSet};
-pub use simplify::{simplify, SimplifyParams, SimplifyStats};
+pub use simplify::{simplify, KeepTopology, SimplifyParams, SimplifyStats};
 pub use tree::{Metric, TreeKind, TreeParams, VsTree};

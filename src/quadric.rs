@@ -80,6 +80,25 @@ impl CellStats {
         x
     }
 
+    /// [`CellStats::quadric_minimizer`] when the truncation would keep every direction, by a
+    /// plain solve without the eigen-decomposition; `None` when that cannot be proved cheaply.
+    /// The smallest eigenvalue must be above [`QUADRIC_TRUNCATION`] times the largest: the
+    /// smallest is at least det / m₂ (m₂ the sum of the principal 2x2 minors, at least the
+    /// product of the two largest) and the largest at most the trace, so det / m₂ > truncation
+    /// × trace proves it. For the many trial points of edge collapses.
+    pub fn quadric_minimizer_if_regular(&self) -> Option<DVec3> {
+        let [xx, xy, xz, yy, yz, zz] = self.nn.0;
+        let trace = xx + yy + zz;
+        let minors = (xx * yy - xy * xy) + (xx * zz - xz * xz) + (yy * zz - yz * yz);
+        let a = self.nn.to_mat3();
+        let det = a.determinant();
+        if trace > 0.0 && minors > 0.0 && det / minors > QUADRIC_TRUNCATION * trace {
+            let m = self.centroid();
+            return Some(m + a.inverse() * (self.b - self.nn.mul_vec(m)));
+        }
+        None
+    }
+
     /// The L2 error: the quadric's value at its minimiser, i.e. the sum over the samples of the
     /// squared distance from the minimiser to each sample's tangent plane (absolute units,
     /// squared; the tree divides it by the squared bounding-box diagonal). Because it is a sum,
@@ -134,6 +153,20 @@ mod tests {
         ]);
         assert!((s.quadric_minimizer() - DVec3::ONE).length() < 1e-12);
         assert!(s.l2_error() < 1e-9);
+    }
+
+    #[test]
+    fn the_fast_minimiser_is_the_truncated_one() {
+        let corner = stats(&[
+            (DVec3::new(1.0, 0.2, 0.3), DVec3::X),
+            (DVec3::new(0.1, 1.0, 0.7), DVec3::new(0.1, 1.0, 0.0)),
+            (DVec3::new(0.4, 0.5, 1.0), DVec3::new(0.0, 0.2, 1.0)),
+        ]);
+        let flat = stats(&[(DVec3::ZERO, DVec3::Z), (DVec3::X, DVec3::new(0.0, 0.05, 1.0)), (DVec3::Y, DVec3::Z)]);
+        let crease = stats(&[(DVec3::ZERO, DVec3::Z), (DVec3::X, DVec3::Y), (DVec3::Y, DVec3::new(0.0, 1.0, 0.3))]);
+        let x = corner.quadric_minimizer_if_regular().unwrap();
+        assert!((x - corner.quadric_minimizer()).length() < 1e-9);
+        assert_eq!((flat.quadric_minimizer_if_regular(), crease.quadric_minimizer_if_regular()), (None, None));
     }
 
     #[test]

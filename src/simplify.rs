@@ -4,15 +4,34 @@
 //! are dropped. The input's winding is kept, and non-manifold input is fine.
 
 use crate::collapse::Collapser;
+use crate::decimate::decimate;
 use crate::error::{shown, Error, Result};
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
 use crate::quadric::CellStats;
 use crate::samples::{MeshSampling, SampleSet};
+use crate::topology::analyze;
 use crate::tree::{self, NodeKind, TreeParams, TreeStats, VsTree};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::time::Instant;
+
+/// Whether [`simplify`] keeps the input's topology.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum KeepTopology {
+    /// On when the input is a closed 2-manifold (watertight: no border, no non-manifold edge
+    /// or vertex, consistently oriented), off otherwise.
+    #[default]
+    Auto,
+    /// Clusters are merged by edge collapses under the link condition ([`crate::collapse`]),
+    /// so a closed 2-manifold gives a closed 2-manifold of the same genus and an open one
+    /// keeps its borders manifold; a cluster the condition keeps in pieces keeps a vertex per
+    /// piece.
+    On,
+    /// Plain vertex clustering (the paper's), which may fuse sheets and make non-manifold
+    /// edges, and is faster.
+    Off,
+}
 
 /// Parameters of [`simplify`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -21,11 +40,18 @@ pub struct SimplifyParams {
     pub sampling: MeshSampling,
     /// Worker threads; 0 = all cores.
     pub threads: usize,
-    /// Keep the topology: clusters are merged by edge collapses under the link condition
-    /// ([`crate::collapse`]), so a closed 2-manifold gives a closed 2-manifold of the same
-    /// genus and an open one keeps its borders manifold; a cluster the condition keeps in
-    /// pieces keeps a vertex per piece. Off: plain vertex clustering, which may fuse sheets.
-    pub keep_topology: bool,
+    /// Whether the topology is kept; by default when the input is a closed 2-manifold.
+    pub keep_topology: KeepTopology,
+    /// Triangles wanted, from 1 to the input's count; 0 = as many as the error bound gives.
+    /// With a target, `tree.error` is no bound: the tree (built at that bound, which only sets
+    /// where the work starts) is grown or cut by splitting the cluster with the largest error
+    /// first until there are about half as many clusters as triangles wanted, and quadric edge
+    /// collapses under the same topology rules bring the count to the target (within one
+    /// triangle: a collapse removes two). A target below what the topology allows (a closed
+    /// surface of genus g needs more triangles than 4 g; a tetrahedron is the least) gives the
+    /// smallest mesh the collapses reach, which [`SimplifyStats::output_triangles`] shows.
+    /// Meshes only: a point cloud with a target is refused.
+    pub target_faces: usize,
 }
 
 /// What [`simplify`] did.
@@ -39,6 +65,8 @@ pub struct SimplifyStats {
     pub seconds_samples: f64,
     pub seconds_tree: f64,
     pub seconds_cluster: f64,
+    /// Whether the topology was kept (see [`KeepTopology`]).
+    pub kept_topology: bool,
 }
 
 /// The clusters of a tree: one per leaf.
@@ -59,21 +87,29 @@ pub const NO_CLUSTER: u32 = u32::MAX;
 
 /// Computes the clusters of `tree`: representatives in parallel, deterministic.
 pub fn cluster(tree: &VsTree, threads: &Threads) -> Clustering {
+    cluster_with_stats(tree, threads).0
+}
+
+/// [`cluster`], with the sums of each cluster's samples (positions relative to the root's
+/// centre), which are its quadric.
+fn cluster_with_stats(tree: &VsTree, threads: &Threads) -> (Clustering, Vec<CellStats>) {
     let leaves: Vec<u32> = tree.leaves().map(|i| i as u32).collect();
     let origin = tree.root().center.as_dvec3();
-    let (representatives, normals): (Vec<Vec3>, Vec<Vec3>) =
+    let (points, stats): (Vec<(Vec3, Vec3)>, Vec<CellStats>) =
         threads.run(|| leaves.par_iter().map(|&leaf| representative(tree, leaf as usize, origin)).unzip());
+    let (representatives, normals) = points.into_iter().unzip();
     let mut sample_cluster = vec![NO_CLUSTER; tree.samples.len()];
     for (k, &leaf) in leaves.iter().enumerate() {
         for s in tree.samples_of(&tree.nodes[leaf as usize]) {
             sample_cluster[s.index as usize] = k as u32;
         }
     }
-    Clustering { representatives, normals, leaves, sample_cluster }
+    (Clustering { representatives, normals, leaves, sample_cluster }, stats)
 }
 
-/// A leaf's representative (see [`tree::representative`]) and its mean normal.
-fn representative(tree: &VsTree, leaf: usize, origin: DVec3) -> (Vec3, Vec3) {
+/// A leaf's representative (see [`tree::representative`]) and its mean normal, and its
+/// samples' sums.
+fn representative(tree: &VsTree, leaf: usize, origin: DVec3) -> ((Vec3, Vec3), CellStats) {
     let node = &tree.nodes[leaf];
     let mut stats = CellStats::default();
     for s in tree.samples_of(node) {
@@ -82,7 +118,7 @@ fn representative(tree: &VsTree, leaf: usize, origin: DVec3) -> (Vec3, Vec3) {
     let frame = (node.kind == NodeKind::Surface).then(|| &tree.frames[node.frame as usize]);
     let x = tree::representative(node, frame, &stats, origin);
     let first = tree.samples_of(node).first().map_or(Vec3::Z, |s| s.normal);
-    (x.as_vec3(), cluster_normal(&stats, first))
+    ((x.as_vec3(), cluster_normal(&stats, first)), stats)
 }
 
 /// The cluster's unit normal: its samples' mean normal. Where the normals cancel out (two
@@ -141,9 +177,20 @@ pub fn cluster_mesh(
 }
 
 /// Simplifies `mesh` (or a point cloud with normals) by clustering in the tree `params`
-/// describe. Returns the simplified mesh and what was done.
+/// describe, to the error bound or to the number of triangles asked for. Returns the
+/// simplified mesh and what was done.
 pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> Result<(Mesh, SimplifyStats)> {
     let threads = Threads::new(params.threads)?;
+    check_target(mesh, params.target_faces)?;
+    let keep = !mesh.is_point_cloud()
+        && match params.keep_topology {
+            KeepTopology::On => true,
+            KeepTopology::Off => false,
+            KeepTopology::Auto => analyze(mesh).is_watertight(),
+        };
+    if params.target_faces > 0 {
+        return simplify_to_size(mesh, params, keep, &threads, progress);
+    }
     let Clustered { samples, tree, clusters, seconds_samples, seconds_tree, seconds_cluster } =
         cluster_mesh(mesh, params, &threads, progress)?;
     let t = Instant::now();
@@ -152,10 +199,10 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
         Mesh::from_points(clusters.representatives, Some(clusters.normals))
     } else {
         let labels = vertex_labels(mesh, &samples, &clusters, params.sampling, &tree);
-        if params.keep_topology {
-            collapse_keeping_topology(mesh, &labels, &clusters.representatives)
+        if keep {
+            collapse_keeping_topology(mesh, &labels, &clusters.representatives).0
         } else {
-            collapse(mesh, &labels, &clusters.representatives, &threads)?
+            collapse(mesh, &labels, &clusters.representatives, &threads)?.0
         }
     };
     out.origin = mesh.origin;
@@ -182,6 +229,131 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
         seconds_samples,
         seconds_tree,
         seconds_cluster: seconds_cluster + t.elapsed().as_secs_f64(),
+        kept_topology: keep,
+    };
+    Ok((out, stats))
+}
+
+/// Refuses a target the input cannot give: more triangles than it has, or any on a cloud.
+fn check_target(mesh: &Mesh, target: usize) -> Result<()> {
+    if target == 0 {
+        return Ok(());
+    }
+    if mesh.triangles.is_empty() {
+        return Err(Error::param(
+            "target_faces",
+            format!("{target} triangles asked of a point cloud: a target needs a mesh (use the error bound)"),
+        ));
+    }
+    if target > mesh.triangles.len() {
+        return Err(Error::param(
+            "target_faces",
+            format!("{target}: more than the input's {} triangles", mesh.triangles.len()),
+        ));
+    }
+    Ok(())
+}
+
+/// Clusters asked for per triangle wanted: a closed triangle mesh has about twice as many
+/// triangles as vertices (Euler: F = 2V - 4 + 4g), and each cluster gives one vertex.
+const CLUSTERS_PER_TRIANGLE: f64 = 0.5;
+
+/// Clusters asked for beyond Euler's estimate (a ratio): plain clustering loses a few
+/// triangles to fused and repeated ones, so the tree is cut a little finer and the quadric
+/// collapses remove the excess. 5% covers what the shared models lose, so one round suffices.
+const CLUSTER_MARGIN: f64 = 1.05;
+
+/// The L2 bound (relative, squared) a sized run builds its tree at before growing it to the
+/// target by largest error: coarse, so the parallel build does the top levels and small targets
+/// need no cut of a deep tree; any start gives the same result up to ties between equal errors
+/// (tree::fit's tests).
+const SEED_ERROR: f64 = 1e-2;
+
+/// At most this many rounds of regrowing the tree when the clustering still gives too few
+/// triangles (each round aims at the target from the count the last one gave).
+const MAX_ROUNDS: usize = 4;
+
+/// The clusters to ask of the tree for `target` triangles, or, after a round that gave
+/// `got` triangles from `clusters` clusters, for the next round.
+fn clusters_for(target: usize, last: Option<(usize, usize)>) -> usize {
+    match last {
+        None => (target as f64 * CLUSTERS_PER_TRIANGLE * CLUSTER_MARGIN).ceil() as usize,
+        Some((clusters, 0)) => 4 * clusters.max(1),
+        Some((clusters, got)) => {
+            let scaled = (clusters as f64 * target as f64 / got as f64 * CLUSTER_MARGIN).ceil() as usize;
+            scaled.max(clusters + 1)
+        }
+    }
+}
+
+/// [`simplify`] with a target size: the tree fitted to the target's clusters (grown again
+/// while the clustering gives too few triangles), then quadric edge collapses to the target.
+fn simplify_to_size(
+    mesh: &Mesh,
+    params: &SimplifyParams,
+    keep: bool,
+    threads: &Threads,
+    progress: &mut Progress,
+) -> Result<(Mesh, SimplifyStats)> {
+    let target = params.target_faces;
+    let t0 = Instant::now();
+    let samples = SampleSet::from_mesh(mesh, params.sampling)?;
+    let t1 = Instant::now();
+    // The tree is grown or cut from here; where it starts matters only for ties.
+    let seed = match params.tree.metric {
+        tree::Metric::L2 => TreeParams { error: params.tree.error.max(SEED_ERROR), ..params.tree },
+        _ => params.tree,
+    };
+    let mut tree = tree::build(&samples, &seed, threads, &mut progress.stage(0.0, 0.6))?;
+    let t2 = Instant::now();
+    progress.report(0.6, "fitting the tree to the size")?;
+    let mut want = clusters_for(target, None);
+    let mut last_leaves = 0;
+    let mut round = 1;
+    let mut cluster_stats: Vec<CellStats>;
+    let (out, out_clusters) = loop {
+        let leaves = tree::fit(&mut tree, want, threads);
+        let (clusters, stats) = cluster_with_stats(&tree, threads);
+        cluster_stats = stats;
+        let labels = vertex_labels(mesh, &samples, &clusters, params.sampling, &tree);
+        let plain = collapse(mesh, &labels, &clusters.representatives, threads)?;
+        // The tree has no leaf left to split: more rounds would give the same clusters.
+        let exhausted = leaves < want || leaves <= last_leaves;
+        let last_round = exhausted || round == MAX_ROUNDS;
+        last_leaves = leaves;
+        round += 1;
+        if plain.0.triangles.len() < target && !last_round {
+            want = clusters_for(target, Some((leaves, plain.0.triangles.len())));
+            continue; // too few already; keeping the topology is the costly part, so skip it
+        }
+        progress.report(0.7, "clustering")?;
+        let out = if keep { collapse_keeping_topology(mesh, &labels, &clusters.representatives) } else { plain };
+        if out.0.triangles.len() >= target || last_round {
+            break out;
+        }
+        want = clusters_for(target, Some((leaves, out.0.triangles.len())));
+    };
+    progress.report(0.9, "collapsing edges to the size")?;
+    let origin = tree.root().center.as_dvec3();
+    let quadrics = out_clusters.iter().map(|&c| cluster_stats[c as usize]).collect();
+    let mut out = if out.triangles.len() > target + 1 { decimate(&out, quadrics, origin, target).0 } else { out };
+    out.origin = mesh.origin;
+    if out.triangles.is_empty() {
+        return Err(Error::input(format!(
+            "every triangle collapsed for a target of {target}: the model has only degenerate or repeated triangles at this size"
+        )));
+    }
+    progress.report(1.0, "done")?;
+    let stats = SimplifyStats {
+        tree: tree.stats(),
+        input_vertices: mesh.positions.len(),
+        input_triangles: mesh.triangles.len(),
+        output_vertices: out.positions.len(),
+        output_triangles: out.triangles.len(),
+        seconds_samples: (t1 - t0).as_secs_f64(),
+        seconds_tree: (t2 - t1).as_secs_f64(),
+        seconds_cluster: t2.elapsed().as_secs_f64(),
+        kept_topology: keep,
     };
     Ok((out, stats))
 }
@@ -235,7 +407,8 @@ pub fn vertex_labels(
 /// Merges each cluster's vertices by edge collapses that keep the topology (see
 /// [`SimplifyParams::keep_topology`]). A cluster left with one vertex puts it at the cluster's
 /// representative; a cluster kept in pieces leaves each at the mean of what it absorbed.
-fn collapse_keeping_topology(mesh: &Mesh, labels: &[u32], representatives: &[Vec3]) -> Mesh {
+/// Returns the mesh and the cluster of each of its vertices.
+fn collapse_keeping_topology(mesh: &Mesh, labels: &[u32], representatives: &[Vec3]) -> (Mesh, Vec<u32>) {
     // Degenerate triangles, and those with a vertex in no cluster, take no part.
     let proper: Vec<[u32; 3]> = mesh
         .triangles
@@ -262,12 +435,13 @@ fn collapse_keeping_topology(mesh: &Mesh, labels: &[u32], representatives: &[Vec
             *p = representatives[label as usize];
         }
     }
-    out
+    (out, out_labels)
 }
 
 /// Re-indexes triangles to clusters, drops collapsed ones and repeats (the first of a repeated
 /// triangle is kept, with its winding), and keeps only the representatives still used.
-fn collapse(mesh: &Mesh, labels: &[u32], representatives: &[Vec3], threads: &Threads) -> Result<Mesh> {
+/// Returns the mesh and the cluster of each of its vertices.
+fn collapse(mesh: &Mesh, labels: &[u32], representatives: &[Vec3], threads: &Threads) -> Result<(Mesh, Vec<u32>)> {
     let (triangles, used) = threads.run(|| {
         let mut keyed: Vec<([u32; 3], u32)> = mesh
             .triangles
@@ -303,13 +477,69 @@ fn collapse(mesh: &Mesh, labels: &[u32], representatives: &[Vec3], threads: &Thr
     });
     let mut new_index = vec![u32::MAX; representatives.len()];
     let mut positions = Vec::new();
+    let mut clusters = Vec::new();
     for (c, _) in used.iter().enumerate().filter(|(_, &u)| u) {
         new_index[c] = positions.len() as u32;
         positions.push(representatives[c]);
+        clusters.push(c as u32);
     }
     let triangles: Vec<[u32; 3]> = triangles.into_iter().map(|t| t.map(|c| new_index[c as usize])).collect();
     if positions.len() > u32::MAX as usize {
         return Err(Error::TooLarge("output vertices".into()));
     }
-    Ok(Mesh::new(positions, None, triangles))
+    Ok((Mesh::new(positions, None, triangles), clusters))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clusters_asked_for_a_target_and_after_a_short_round() {
+        assert_eq!((CLUSTERS_PER_TRIANGLE, CLUSTER_MARGIN, MAX_ROUNDS), (0.5, 1.05, 4));
+        // Euler's half, 5% more.
+        assert_eq!(clusters_for(1000, None), 525);
+        // A round that gave 900 triangles from 500 clusters: scaled to 1000, 5% more.
+        assert_eq!(clusters_for(1000, Some((500, 900))), 584);
+        // Never fewer than one more cluster, and four times as many after a round with none.
+        assert_eq!(clusters_for(1000, Some((500, 5000))), 501);
+        assert_eq!(clusters_for(1000, Some((500, 0))), 2000);
+    }
+
+    #[test]
+    fn a_sized_run_does_not_depend_on_the_bound_it_starts_from() {
+        // The seed only sets where the tree's growth starts: below it (1e-1, coarser) the seed
+        // is SEED_ERROR, above it (1e-5) the finer tree is cut; the output is the same.
+        assert_eq!(SEED_ERROR, 1e-2);
+        let mesh = crate::shapes::torus(1.0, 0.3, 96, 48);
+        let run = |error| {
+            let tree = TreeParams { error, ..TreeParams::default() };
+            let params = SimplifyParams { tree, target_faces: 600, ..Default::default() };
+            simplify(&mesh, &params, &mut Progress::none()).unwrap().0
+        };
+        let (coarse, fine) = (run(1e-1), run(1e-5));
+        assert_eq!(coarse, fine);
+        assert!(coarse.triangles.len().abs_diff(600) <= 2);
+    }
+
+    #[test]
+    fn one_round_suffices_on_closed_shapes() {
+        // The margin is meant to make the first round give enough triangles: on these shapes,
+        // the clustering of the first round's clusters already has the target's count.
+        for (mesh, target) in [(crate::shapes::icosphere(1.0, 5), 2000), (crate::shapes::torus(1.0, 0.3, 192, 96), 700)]
+        {
+            let samples = SampleSet::from_mesh(&mesh, MeshSampling::Vertices).unwrap();
+            let threads = Threads::new(1).unwrap();
+            let mut tree = tree::build(&samples, &TreeParams::default(), &threads, &mut Progress::none()).unwrap();
+            tree::fit(&mut tree, clusters_for(target, None), &threads);
+            let clusters = cluster(&tree, &threads);
+            let labels = vertex_labels(&mesh, &samples, &clusters, MeshSampling::Vertices, &tree);
+            let (kept, _) = collapse_keeping_topology(&mesh, &labels, &clusters.representatives);
+            let (plain, _) = collapse(&mesh, &labels, &clusters.representatives, &threads).unwrap();
+            for out in [kept, plain] {
+                let n = out.triangles.len();
+                assert!(n >= target && n < target * 11 / 10, "{n} triangles for {target}");
+            }
+        }
+    }
 }

@@ -164,3 +164,27 @@ fn a_mesh_with_a_non_finite_origin_is_refused() {
     mesh.origin = glam::DVec3::new(f64::NAN, 0.0, 0.0);
     assert!(message(simplify_default(&mesh)).contains("the origin [NaN, 0, 0] is not finite"));
 }
+
+#[test]
+fn targets_the_input_cannot_give_are_refused_or_give_the_nearest_mesh() {
+    let sphere = vstree::shapes::icosphere(1.0, 3); // 1280 triangles
+    let with = |mesh: &Mesh, target_faces| {
+        simplify(mesh, &SimplifyParams { target_faces, ..Default::default() }, &mut Progress::none())
+    };
+    // More triangles than the input has: refused, naming the parameter.
+    let e = with(&sphere, 1281).unwrap_err();
+    assert!(matches!(e, Error::InvalidParameter { name: "target_faces", .. }), "{e}");
+    assert!(e.to_string().contains("more than the input's 1280 triangles"), "{e}");
+    // A point cloud has no triangles to count.
+    let e = with(&cloud(&[Vec3::ZERO, Vec3::X, Vec3::Y]), 10).unwrap_err();
+    assert!(e.to_string().contains("a target needs a mesh"), "{e}");
+    // The whole input: every triangle kept.
+    assert_eq!(with(&sphere, 1280).unwrap().0.triangles.len(), 1280);
+    // Below what a closed sphere allows: a tetrahedron, never an empty mesh.
+    for target in [1, 2, 3] {
+        let (out, _) = with(&sphere, target).unwrap();
+        assert_eq!(out.triangles.len(), 4, "target {target}");
+    }
+    // 0 is the error bound, as without a target.
+    assert_eq!(with(&sphere, 0).unwrap().0, simplify_default(&sphere).unwrap().0);
+}

@@ -240,6 +240,19 @@ fn cases() -> Vec<Case> {
             usage_error("invalid value 'x' for '--levels <LEVELS>': invalid digit found in string"),
         ),
         // Unknown values, unknown flags, missing arguments.
+        // Sizes: a count the input has, a ratio in (0, 1], one way to ask, meshes only.
+        fail("simplify --faces 1281", vec![sphere_ply()], &simplify_with(&["--faces", "1281"]), error("--faces: 1281: more than the input's 1280 triangles")),
+        fail("simplify --faces -5", vec![sphere_ply()], &simplify_with(&["--faces", "-5"]), error("--faces: -5: must be a triangle count >= 1 (0 = use --error)")),
+        usage("simplify --faces x", vec![sphere_ply()], &simplify_with(&["--faces", "x"]), usage_error("invalid value 'x' for '--faces <FACES>': invalid digit found in string")),
+        fail("simplify --ratio 0", vec![sphere_ply()], &simplify_with(&["--ratio", "0"]), error("--ratio: 0: must be in (0, 1], a fraction of the input's triangles")),
+        fail("simplify --ratio 1.5", vec![sphere_ply()], &simplify_with(&["--ratio", "1.5"]), error("--ratio: 1.5: must be in (0, 1], a fraction of the input's triangles")),
+        fail("simplify --ratio -0.1", vec![sphere_ply()], &simplify_with(&["--ratio", "-0.1"]), error("--ratio: -0.1: must be in (0, 1], a fraction of the input's triangles")),
+        fail("simplify --ratio NaN", vec![sphere_ply()], &simplify_with(&["--ratio", "NaN"]), error("--ratio: NaN: must be in (0, 1], a fraction of the input's triangles")),
+        usage("simplify --faces --ratio", vec![sphere_ply()], &simplify_with(&["--faces", "100", "--ratio", "0.1"]), usage_error("the argument '--faces <FACES>' cannot be used with '--ratio <RATIO>'\n\nUsage: vstree simplify --faces <FACES> <INPUT> <OUTPUT>")),
+        usage("simplify --faces --error", vec![sphere_ply()], &simplify_with(&["--faces", "100", "--error", "1e-3"]), usage_error("the argument '--faces <FACES>' cannot be used with '--error <ERROR>'\n\nUsage: vstree simplify --faces <FACES> <INPUT> <OUTPUT>")),
+        usage("simplify --ratio --error", vec![sphere_ply()], &simplify_with(&["--ratio", "0.1", "--error", "1e-3"]), usage_error("the argument '--ratio <RATIO>' cannot be used with '--error <ERROR>'\n\nUsage: vstree simplify --ratio <RATIO> <INPUT> <OUTPUT>")),
+        usage("simplify --keep-topology --no-keep-topology", vec![sphere_ply()], &simplify_with(&["--keep-topology", "--no-keep-topology"]), usage_error("the argument '--keep-topology' cannot be used with '--no-keep-topology'\n\nUsage: vstree simplify --keep-topology <INPUT> <OUTPUT>")),
+        fail("simplify a cloud --faces 10", vec![cloud_ply()], &["simplify", "cloud.ply", "out.ply", "--faces", "10"], error("--faces: 10 triangles asked of a point cloud: a target needs a mesh (use the error bound)")),
         usage("simplify --tree bsp", vec![sphere_ply()], &simplify_with(&["--tree", "bsp"]), usage_error("invalid value 'bsp' for '--tree <TREE>'\n  [possible values: vstree, octree]")),
         usage("simplify --metric l3", vec![sphere_ply()], &simplify_with(&["--metric", "l3"]), usage_error("invalid value 'l3' for '--metric <METRIC>'\n  [possible values: l2, l21, density]")),
         usage(
@@ -393,7 +406,7 @@ fn cases() -> Vec<Case> {
         fail(
             "simplify --error 100 collapses every triangle",
             vec![sphere_ply()],
-            &simplify_with(&["--error", "100", "-q"]),
+            &simplify_with(&["--error", "100", "--no-keep-topology", "-q"]),
             error("--error: 100: every triangle collapsed (1 cluster for the whole model): the model is within this bound of too few planes; use a smaller bound (a flat model, within any bound of one plane, needs the density metric)"),
         ),
         fail("reconstruct --tree octree", vec![cloud_ply()], &reconstruct_with(&["--tree", "octree"]), error("--tree: octree: reconstruction needs the VS-Tree, whose T-nodes make the base mesh (the octree is for simplification)")),
@@ -440,6 +453,30 @@ fn cases() -> Vec<Case> {
             vec![sphere_ply()],
             &simplify_with(&["--threads", "1024"]),
             exact(&threads_note),
+        )
+    });
+    // A size the topology cannot reach: the smallest closed mesh, and a warning (not an
+    // empty mesh, not an error).
+    cases.push(Case {
+        quiet_stdout: false,
+        creates: Some("out.ply".into()),
+        code: 0,
+        ..fail(
+            "simplify --faces 1 on a sphere gives a tetrahedron",
+            vec![sphere_ply()],
+            &simplify_with(&["--faces", "1", "-q"]),
+            exact("vstree: warning: 4 triangles instead of the 1 asked for: fewer would change the topology (genus, borders); --no-keep-topology allows it\n"),
+        )
+    });
+    cases.push(Case {
+        quiet_stdout: false,
+        creates: Some("out.ply".into()),
+        code: 0,
+        ..fail(
+            "simplify --faces 0 uses the bound",
+            vec![sphere_ply()],
+            &simplify_with(&["--faces", "0", "-q"]),
+            exact(""),
         )
     });
     let mut bom = b"\xEF\xBB\xBF".to_vec();

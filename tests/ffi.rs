@@ -44,7 +44,7 @@ fn simplify_through_the_abi_equals_the_rust_call() {
             },
             sampling: [vstree::MeshSampling::Vertices, vstree::MeshSampling::FaceCenters][sampling as usize],
             threads: 0,
-            keep_topology: false,
+            ..Default::default()
         };
         let (expected, s) = simplify(&sphere, &rust_params, &mut Progress::none()).unwrap();
         assert_eq!(out, expected);

@@ -21,7 +21,8 @@ fn run(
         tree: TreeParams { kind, error, ..TreeParams::default() },
         sampling,
         threads,
-        keep_topology: false,
+        keep_topology: vstree::KeepTopology::Off,
+        target_faces: 0,
     };
     simplify(mesh, &params, &mut Progress::none()).unwrap()
 }

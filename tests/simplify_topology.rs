@@ -8,6 +8,7 @@ use vstree::tree::TreeParams;
 use vstree::{shapes, simplify, Mesh, Progress, SimplifyParams};
 
 fn simplified(mesh: &Mesh, error: f64, keep_topology: bool) -> Mesh {
+    let keep_topology = if keep_topology { vstree::KeepTopology::On } else { vstree::KeepTopology::Off };
     let params =
         SimplifyParams { tree: TreeParams { error, ..Default::default() }, keep_topology, ..Default::default() };
     simplify(mesh, &params, &mut Progress::none()).unwrap().0

@@ -29,6 +29,7 @@ namespace {
 const QStringList kTreeKinds{"VS-Tree", "Octree"};
 const QStringList kMetrics{"L2 (quadric)", "L2,1 (normal deviation)", "Density (samples)"};
 const QStringList kSamplings{"Vertices", "Face centers"};
+const QStringList kKeepTopology{"Auto (closed manifolds)", "On", "Off"};
 const QStringList kLabelKinds{"Cluster", "T-node"};
 
 // A vstree status other than OK becomes an MLException carrying the C API's own message;
@@ -193,6 +194,49 @@ vstree_simplify_params simplifyParams(const RichParameterList& par, double diago
 	return p;
 }
 
+// The size and topology parameters of the simplification filter (like MeshLab's quadric edge
+// collapse: a face count, or a fraction of the input's faces that overrides it), with the
+// library's defaults `d`.
+void addSizeParams(RichParameterList& pl, const vstree_simplify_params& d)
+{
+	pl.addParam(RichInt("target_faces", int(d.target_faces), "Target number of faces",
+		"The number of triangles wanted (within one): the tree is grown or cut, splitting the "
+		"cluster with the largest error first, and quadric edge collapses finish the count. The "
+		"error bound then only sets where the work starts. 0 uses the error bound. A closed "
+		"surface cannot go below what its genus needs (a tetrahedron's 4 at least): the result is "
+		"then the smallest mesh reachable, and the log says so."));
+	pl.addParam(RichFloat("target_perc", 0, "Percentage reduction (0..1)",
+		"If non zero, the wanted size as a fraction of the input's faces (0.1 keeps 10%); it "
+		"overrides the target number of faces."));
+	pl.addParam(RichEnum("keep_topology", d.keep_topology, kKeepTopology, "Keep topology",
+		"Auto: for closed 2-manifold inputs, clusters merge by edge collapses that keep the mesh "
+		"closed and manifold with its genus; other inputs get plain clustering. On: keep the "
+		"topology of any input (open borders stay manifold). Off: plain vertex clustering, faster, "
+		"which may fuse close sheets into non-manifold edges."));
+}
+
+// Sets the size and topology fields from the filter's parameters, for an input of `faces`
+// triangles.
+void setSize(const RichParameterList& par, size_t faces, vstree_simplify_params& p)
+{
+	const double perc = double(par.getFloat("target_perc"));
+	const int target = par.getInt("target_faces");
+	if (!(perc >= 0 && perc <= 1))
+		throw MLException(QString("vstree: 'Percentage reduction' is %1: it must be in (0, 1], or 0 to use the "
+								  "target number of faces").arg(perc));
+	if (target < 0)
+		throw MLException(QString("vstree: 'Target number of faces' is %1: it must be at least 1, or 0 to use "
+								  "the error bound").arg(target));
+	p.target_faces = uint32_t(target);
+	if (perc > 0)
+		p.target_faces = uint32_t(std::max(1.0, std::round(perc * double(faces))));
+	switch (par.getEnum("keep_topology")) {
+	case 1: p.keep_topology = VSTREE_KEEP_TOPOLOGY_ON; break;
+	case 2: p.keep_topology = VSTREE_KEEP_TOPOLOGY_OFF; break;
+	default: p.keep_topology = VSTREE_KEEP_TOPOLOGY_AUTO; break;
+	}
+}
+
 // The tree's parameters, with the library's defaults (`d`, from vstree_simplify_params_default()).
 void addTreeParams(RichParameterList& pl, const vstree_simplify_params& d, double diagonal)
 {
@@ -318,6 +362,7 @@ RichParameterList FilterVstreePlugin::initParameterList(const QAction* a, const 
 	const double diagonal = double(m.cm.bbox.Diag());
 	switch (ID(a)) {
 	case FP_SIMPLIFY:
+		addSizeParams(pl, vstree_simplify_params_default());
 		addTreeParams(pl, vstree_simplify_params_default(), diagonal);
 		break;
 	case FP_COLOUR:
@@ -368,7 +413,8 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 	case FP_SIMPLIFY: {
 		MeshHandle in;
 		makeInput(a, passNormals, in);
-		const vstree_simplify_params p = simplifyParams(par, double(src->cm.bbox.Diag()));
+		vstree_simplify_params p = simplifyParams(par, double(src->cm.bbox.Diag()));
+		setSize(par, a.tri.size() / 3, p);
 		vstree_simplify_result* res = nullptr;
 		check(vstree_simplify(in.p, &p, progressTrampoline, &prog, &res), "simplify");
 		struct Free { vstree_simplify_result* r; ~Free() { vstree_simplify_result_free(r); } } guard{res};
@@ -382,9 +428,21 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 			(unsigned long long)s->clusters, (unsigned long long)s->v_nodes,
 			(unsigned long long)s->t_nodes, (unsigned long long)s->s_nodes, s->max_depth,
 			s->seconds_total);
+		log("topology %s", s->kept_topology ? "kept" : "not kept (plain clustering)");
+		if (s->target_faces > 0) {
+			const uint64_t slack = std::max<uint64_t>(2, s->target_faces / 100);
+			const uint64_t got = s->output_triangles, want = s->target_faces;
+			if ((got > want ? got - want : want - got) > slack)
+				log("%llu triangles instead of the %llu asked for: %s", (unsigned long long)got,
+					(unsigned long long)want,
+					got > want ? (s->kept_topology ? "fewer would change the topology; set 'Keep topology' to Off to allow it"
+												   : "no further edge collapses without folding the surface")
+							   : "the input has no more distinct clusters to give");
+		}
 		out["output_vertices"] = QVariant(int(s->output_vertices));
 		out["output_triangles"] = QVariant(int(s->output_triangles));
 		out["clusters"] = QVariant(int(s->clusters));
+		out["kept_topology"] = QVariant(int(s->kept_topology));
 		out["t_nodes"] = QVariant(int(s->t_nodes));
 		out["new_mesh_id"] = QVariant(dst->id());
 		break;

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 use vstree::reconstruct::{reconstruct, Closure, ReconstructParams, ReconstructStats, RefinementStop};
-use vstree::simplify::{simplify, SimplifyParams, SimplifyStats};
+use vstree::simplify::{simplify, KeepTopology, SimplifyParams, SimplifyStats};
 use vstree::tree::{Metric, TreeKind, TreeParams, TreeStats};
 use vstree::{io, MeshSampling, Progress, SampleSet, Threads};
 
@@ -29,7 +29,9 @@ enum Command {
     ///
     /// Every leaf of the tree becomes one output vertex, placed where it best fits the samples'
     /// tangent planes; triangles are re-indexed, and those that collapse are dropped. A point
-    /// cloud without normals gets them estimated first.
+    /// cloud without normals gets them estimated first. The size is set by the error bound
+    /// (--error), or exactly by --faces or --ratio. A closed 2-manifold input keeps its
+    /// topology unless --no-keep-topology is given.
     Simplify {
         /// Input file: .ply, .obj, .off, .xyz or .pwn.
         input: PathBuf,
@@ -40,12 +42,28 @@ enum Command {
         /// Which mesh elements become samples.
         #[arg(long, value_enum, default_value_t = Sampling::Vertices)]
         sampling: Sampling,
+        /// Triangles wanted (instead of --error): the tree is grown or cut, splitting the
+        /// cluster with the largest error first, and quadric edge collapses bring the mesh to
+        /// this count (within one triangle). Below what the topology allows (a closed surface
+        /// of genus g needs more than 4 g triangles, a tetrahedron's 4 at least) the output is
+        /// the smallest mesh reachable, and a warning says so. 0 = use the error bound.
+        #[arg(long, allow_negative_numbers = true, conflicts_with_all = ["ratio", "error"])]
+        faces: Option<i64>,
+        /// Fraction of the input's triangles wanted, in (0, 1] (instead of --error): 0.1 keeps
+        /// 10%, rounded, at least 1 triangle; then as --faces.
+        #[arg(long, allow_negative_numbers = true, conflicts_with = "error")]
+        ratio: Option<f64>,
         /// Keep the topology: clusters merge by edge collapses that keep a closed 2-manifold
         /// closed and manifold with its genus (and an open one's borders manifold); a cluster
         /// that cannot merge without changing the topology keeps a vertex per piece, so the
-        /// output may have more vertices than clusters.
-        #[arg(long)]
+        /// output may have more vertices than clusters. The default for closed 2-manifold
+        /// inputs; this flag asks for it on any input.
+        #[arg(long, conflicts_with = "no_keep_topology")]
         keep_topology: bool,
+        /// Plain vertex clustering even for a closed 2-manifold input: faster, but sheets
+        /// closer than a cluster may fuse, with non-manifold edges and another genus.
+        #[arg(long)]
+        no_keep_topology: bool,
         /// Write PLY as text instead of binary.
         #[arg(long)]
         ascii: bool,
@@ -250,6 +268,8 @@ fn message(e: &vstree::Error) -> String {
         "max_depth" => "--max-depth",
         "min_cell_size" => "--min-cell-size",
         "threads" => "--threads",
+        "target_faces" => "--faces",
+        "ratio" => "--ratio",
         "target_distance" => "--target",
         "max_levels" => "--levels",
         "trim" => "--trim",
@@ -306,19 +326,31 @@ fn read_with_normals(path: &Path, threads: usize, quiet: bool) -> vstree::Result
 
 fn run(command: Command) -> vstree::Result<()> {
     match command {
-        Command::Simplify { input, output, tree, sampling, keep_topology, ascii } => {
+        Command::Simplify { input, output, tree, sampling, faces, ratio, keep_topology, no_keep_topology, ascii } => {
             let tree_params = tree.params(SIMPLIFY_ERROR);
             tree_params.check()?; // before reading what may be a large file
+            let size = Size::from_flags(faces, ratio)?;
             let target = reserve_output(&input, &output)?;
             say_threads(tree.threads, tree.quiet);
             let (mesh, read_s) = timed(|| read_with_normals(&input, tree.threads, tree.quiet))?;
-            let params =
-                SimplifyParams { tree: tree_params, sampling: sampling.into(), threads: tree.threads, keep_topology };
+            let keep_topology = match (keep_topology, no_keep_topology) {
+                (true, _) => KeepTopology::On,
+                (_, true) => KeepTopology::Off,
+                _ => KeepTopology::Auto,
+            };
+            let params = SimplifyParams {
+                tree: tree_params,
+                sampling: sampling.into(),
+                threads: tree.threads,
+                keep_topology,
+                target_faces: size.faces(mesh.triangles.len()),
+            };
             let (out, stats) = with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
             let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
                 print_simplify(&input, &output, &stats, read_s, write_s);
             }
+            say_size_missed(params.target_faces, &stats);
             Ok(())
         }
         Command::Reconstruct {
@@ -397,6 +429,58 @@ fn run(command: Command) -> vstree::Result<()> {
     }
 }
 
+/// The size `simplify` is asked for.
+enum Size {
+    /// The error bound decides.
+    Bound,
+    Faces(usize),
+    /// A fraction of the input's triangles, in (0, 1].
+    Ratio(f64),
+}
+
+impl Size {
+    /// Checks `--faces` and `--ratio` (at most one is given) before the input is read.
+    fn from_flags(faces: Option<i64>, ratio: Option<f64>) -> vstree::Result<Size> {
+        let bad = |name, message: String| Err(vstree::Error::InvalidParameter { name, message });
+        match (faces, ratio) {
+            (Some(n), _) if n < 0 => {
+                bad("target_faces", format!("{n}: must be a triangle count >= 1 (0 = use --error)"))
+            }
+            (Some(0), _) | (None, None) => Ok(Size::Bound),
+            (Some(n), _) => Ok(Size::Faces(usize::try_from(n).unwrap_or(usize::MAX))),
+            (None, Some(r)) if !(r > 0.0 && r <= 1.0) => {
+                bad("ratio", format!("{r}: must be in (0, 1], a fraction of the input's triangles"))
+            }
+            (None, Some(r)) => Ok(Size::Ratio(r)),
+        }
+    }
+
+    /// The `target_faces` for an input of `triangles` triangles.
+    fn faces(&self, triangles: usize) -> usize {
+        match *self {
+            Size::Bound => 0,
+            Size::Faces(n) => n,
+            Size::Ratio(r) => ((r * triangles as f64).round() as usize).max(1),
+        }
+    }
+}
+
+/// Warns when the output is farther from the size asked for than 1% (or 2 triangles): the
+/// topology, or an input with fewer distinct triangles, allowed no closer result.
+fn say_size_missed(target: usize, s: &SimplifyStats) {
+    let slack = (target / 100).max(2);
+    if target > 0 && s.output_triangles.abs_diff(target) > slack {
+        let why = if s.output_triangles > target && s.kept_topology {
+            "fewer would change the topology (genus, borders); --no-keep-topology allows it"
+        } else if s.output_triangles > target {
+            "no further edge can collapse without folding the surface or pinching it"
+        } else {
+            "the input has no more distinct clusters to give"
+        };
+        eprintln!("vstree: warning: {} triangles instead of the {target} asked for: {why}", s.output_triangles);
+    }
+}
+
 /// Says when `--threads` asks for more threads than the machine has cores (they would only
 /// take turns), since the library then uses one per core.
 fn say_threads(requested: usize, quiet: bool) {
@@ -447,6 +531,7 @@ fn print_simplify(input: &Path, output: &Path, s: &SimplifyStats, read_s: f64, w
     println!("samples: {}", s.tree.samples);
     print_tree(&s.tree);
     println!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
+    println!("topology: {}", if s.kept_topology { "kept" } else { "not kept (plain clustering)" });
     println!(
         "time: read {:.3} s, samples {:.3} s, tree {:.3} s, clustering {:.3} s, write {:.3} s",
         read_s, s.seconds_samples, s.seconds_tree, s.seconds_cluster, write_s

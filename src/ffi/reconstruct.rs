@@ -72,10 +72,10 @@ pub struct vstree_reconstruct_params {
     pub threads: u32,
     /// Open or closed output, a VSTREE_CLOSURE_* value. Default VSTREE_CLOSURE_CLOSED; use
     /// VSTREE_CLOSURE_OPEN for a scan from one side (only the part of the surface the points
-    /// support is kept). Since 0.1.3.
+    /// support is kept). Since 0.2.0.
     pub closure: i32,
     /// Must be 0 (keeps the struct free of padding; a later version may give it a meaning).
-    /// Since 0.1.3.
+    /// Since 0.2.0.
     pub reserved: u32,
 }
 
@@ -254,12 +254,12 @@ pub struct vstree_reconstruct_stats {
     /// polygonisation had handles and the thickened one fewer), else 0. Since 0.1.1.
     pub thickened: u32,
     /// 1 when the output is open (only the part of the surface the points support), else 0.
-    /// Since 0.1.3.
+    /// Since 0.2.0.
     pub open: u32,
-    /// Edges of the base mesh M0 with one face (0 when M0 is closed). Since 0.1.3.
+    /// Edges of the base mesh M0 with one face (0 when M0 is closed). Since 0.2.0.
     pub base_boundary_edges: u32,
     /// Share of the closed polygonised surface's area far from every point (about half for a
-    /// scan from one side); `closure` AUTO makes the output open above 0.15. Since 0.1.3.
+    /// scan from one side); `closure` AUTO makes the output open above 0.15. Since 0.2.0.
     pub unsupported_share: f64,
 }
 

@@ -6,7 +6,7 @@ use super::params::{self, one_of, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::{guard, guard_or, non_null, vstree_status, write_out, FfiResult};
 use crate::samples::MeshSampling;
-use crate::simplify::{simplify, SimplifyParams};
+use crate::simplify::{simplify, KeepTopology, SimplifyParams};
 use crate::tree::{Metric, TreeKind, TreeParams, TreeStats};
 use std::ffi::c_void;
 use std::time::Instant;
@@ -49,6 +49,22 @@ pub enum vstree_sampling {
     FaceCenters = 1,
 }
 
+/// Whether vstree_simplify() keeps the input's topology (the `keep_topology` field).
+#[repr(i32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum vstree_keep_topology {
+    /// Keep it when the input is a closed 2-manifold (no border, no non-manifold edge or
+    /// vertex, consistently oriented); plain clustering otherwise. The default.
+    Auto = 0,
+    /// Clusters merge by edge collapses under the link condition: a closed 2-manifold stays
+    /// closed and manifold with its genus, an open one keeps its borders manifold. A cluster
+    /// that cannot merge without changing the topology keeps a vertex per piece.
+    On = 1,
+    /// Plain vertex clustering (the paper's): faster, but it may fuse sheets and make
+    /// non-manifold edges.
+    Off = 2,
+}
+
 /// Parameters of vstree_simplify() and vstree_tree_build(). Always start from
 /// vstree_simplify_params_default() and change fields by name: it sets `struct_size`, and
 /// fields added in later versions then keep their defaults. Passing NULL means the defaults.
@@ -83,6 +99,18 @@ pub struct vstree_simplify_params {
     /// Cells smaller than this fraction of the bounding-box diagonal are not split (guards
     /// against duplicate points). In [0, 1); default 1e-7.
     pub min_cell_size: f64,
+    /// A vstree_keep_topology value. Default VSTREE_KEEP_TOPOLOGY_AUTO. Since 0.2.0 (callers
+    /// built against an older header get the default).
+    pub keep_topology: i32,
+    /// Triangles wanted, from 1 to the input's count; 0 (the default) = as many as `error`
+    /// gives. With a target, `error` is no bound: the tree is grown or cut, splitting the
+    /// cluster with the largest error first, to about half as many clusters as triangles
+    /// wanted, and quadric edge collapses (under the same topology rules) bring the mesh to
+    /// the target, within one triangle. A target below what the topology allows (a closed
+    /// surface of genus g needs more than 4 g triangles; a tetrahedron, 4, is the least) gives
+    /// the smallest mesh the collapses reach: compare the stats' `output_triangles`. Meshes
+    /// only; ignored by vstree_tree_build(). Since 0.2.0.
+    pub target_faces: u32,
 }
 
 unsafe impl Versioned for vstree_simplify_params {
@@ -101,6 +129,8 @@ unsafe impl Versioned for vstree_simplify_params {
             max_depth: tree.max_depth,
             threads: 0,
             min_cell_size: tree.min_cell_size,
+            keep_topology: vstree_keep_topology::Auto as i32,
+            target_faces: 0,
         }
     }
 }
@@ -150,7 +180,22 @@ pub(crate) unsafe fn read_params(pointer: *const vstree_simplify_params) -> FfiR
     if p.threads > 1024 {
         return Err(super::Failure::parameter("threads", format!("{}: must be 0 (all cores) to 1024", p.threads)));
     }
-    Ok(SimplifyParams { tree, sampling, threads: p.threads as usize, keep_topology: false })
+    let keep_topology = match one_of(
+        "keep_topology",
+        p.keep_topology,
+        &[(0, "VSTREE_KEEP_TOPOLOGY_AUTO"), (1, "VSTREE_KEEP_TOPOLOGY_ON"), (2, "VSTREE_KEEP_TOPOLOGY_OFF")],
+    )? {
+        0 => KeepTopology::Auto,
+        1 => KeepTopology::On,
+        _ => KeepTopology::Off,
+    };
+    Ok(SimplifyParams {
+        tree,
+        sampling,
+        threads: p.threads as usize,
+        keep_topology,
+        target_faces: p.target_faces as usize,
+    })
 }
 
 /// What a simplification did. Owned by its result (vstree_simplify_result_get_stats()); later
@@ -198,6 +243,10 @@ pub struct vstree_simplify_stats {
     pub seconds_cluster: f64,
     /// Seconds in the whole library call, from parameter check to result.
     pub seconds_total: f64,
+    /// 1 when the topology was kept (see vstree_keep_topology), else 0. Since 0.2.0.
+    pub kept_topology: u32,
+    /// The `target_faces` asked for (0: the error bound was used). Since 0.2.0.
+    pub target_faces: u32,
 }
 
 /// Fills the tree part of a stats struct.
@@ -264,6 +313,8 @@ pub unsafe extern "C" fn vstree_simplify(
             seconds_tree: s.seconds_tree,
             seconds_cluster: s.seconds_cluster,
             seconds_total: start.elapsed().as_secs_f64(),
+            kept_topology: u32::from(s.kept_topology),
+            target_faces: params.target_faces as u32,
         };
         let result = Box::new(vstree_simplify_result { mesh: vstree_mesh { mesh: out }, stats });
         unsafe { write_out(out_result, Box::into_raw(result)) };
@@ -333,10 +384,12 @@ mod tests {
 
     #[test]
     fn params_layout_has_no_padding() {
-        assert_eq!(size_of::<vstree_simplify_params>(), 48);
+        assert_eq!(size_of::<vstree_simplify_params>(), 56);
         assert_eq!(offset_of!(vstree_simplify_params, error), 16);
         assert_eq!(offset_of!(vstree_simplify_params, min_cell_size), 40);
-        assert_eq!(size_of::<vstree_simplify_stats>(), 16 + 10 * 8 + 6 * 8);
+        assert_eq!(offset_of!(vstree_simplify_params, keep_topology), 48);
+        assert_eq!(offset_of!(vstree_simplify_params, target_faces), 52);
+        assert_eq!(size_of::<vstree_simplify_stats>(), 16 + 10 * 8 + 6 * 8 + 8);
     }
 
     #[test]
@@ -350,12 +403,18 @@ mod tests {
         assert!(e.message.contains("params->struct_size"), "{}", e.message);
         p.struct_size = 4096;
         assert!(unsafe { read_params(&p) }.unwrap_err().message.contains("newer vstree.h"));
+        // A caller built against 0.1 (48 bytes): whatever lies after its struct, the fields
+        // added in 0.2 keep their defaults.
+        let mut p = vstree_simplify_params_default();
+        (p.struct_size, p.keep_topology, p.target_faces, p.threads) = (48, 99, 7, 3);
+        let read = unsafe { read_params(&p) }.unwrap();
+        assert_eq!((read.keep_topology, read.target_faces, read.threads), (KeepTopology::Auto, 0, 3));
     }
 
     #[test]
     fn every_field_is_checked_by_name() {
         type Spoil = fn(&mut vstree_simplify_params);
-        let cases: [(&str, Spoil); 9] = [
+        let cases: [(&str, Spoil); 10] = [
             ("tree_kind", |p| p.tree_kind = 7),
             ("metric", |p| p.metric = -1),
             ("sampling", |p| p.sampling = 2),
@@ -365,6 +424,7 @@ mod tests {
             ("max_depth", |p| p.max_depth = 31),
             ("min_cell_size", |p| p.min_cell_size = 1.0),
             ("threads", |p| p.threads = 5000),
+            ("keep_topology", |p| p.keep_topology = 3),
         ];
         for (field, spoil) in cases {
             let mut p = vstree_simplify_params_default();

@@ -6,9 +6,9 @@ use std::ffi::c_char;
 /// Major version (semver) of the library this header belongs to.
 pub const VSTREE_VERSION_MAJOR: u32 = 0;
 /// Minor version (semver).
-pub const VSTREE_VERSION_MINOR: u32 = 1;
+pub const VSTREE_VERSION_MINOR: u32 = 2;
 /// Patch version (semver).
-pub const VSTREE_VERSION_PATCH: u32 = 2;
+pub const VSTREE_VERSION_PATCH: u32 = 0;
 /// The ABI version: the number in the shared library's SONAME (`libvstree.so.0`). It changes
 /// only when a change breaks programs built against an earlier header; adding functions,
 /// statuses, or fields at the end of a versioned struct does not change it.

@@ -25,7 +25,7 @@ const FRONTIER: u32 = 32 * 1024;
 const STATS_CHUNK: usize = 1 << 15;
 
 /// A node index with the sums of its samples (computed while partitioning its parent).
-type Pending = (usize, CellStats);
+pub(super) type Pending = (usize, CellStats);
 
 /// Builds the tree `params` describes over `samples`.
 pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progress: &mut Progress) -> Result<VsTree> {
@@ -40,12 +40,7 @@ pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progre
     // rounding of the coordinates), in proportion to the input's own scale so that the tree
     // does not depend on units; never zero.
     let half = 0.5 * extent * (1.0 + 1e-4) + 1e-6 * (extent + center.abs().max_element()) + 1e-30;
-    let builder = Builder {
-        params: *params,
-        origin: center.as_dvec3(),
-        abs_error: params.error * f64::from(diagonal).powi(2),
-        min_half: (0.5 * params.min_cell_size * f64::from(diagonal)) as f32,
-    };
+    let builder = Builder::new(params, center, diagonal);
 
     let mut work: Vec<TreeSample> = threads.run(|| {
         (samples.positions.par_iter(), samples.normals.par_iter())
@@ -144,13 +139,13 @@ fn check_samples(samples: &SampleSet) -> Result<()> {
 /// A piece of the tree under construction: its nodes, the frames it created, and the samples
 /// it owns. Frames numbered below `shared_frames.len()` were made earlier; a local frame `k`
 /// is numbered `shared_frames.len() + k` until it is appended.
-struct Part<'a> {
-    nodes: Vec<Node>,
-    frames: Vec<Frame>,
-    shared_frames: &'a [Frame],
-    samples: &'a mut [TreeSample],
+pub(super) struct Part<'a> {
+    pub(super) nodes: Vec<Node>,
+    pub(super) frames: Vec<Frame>,
+    pub(super) shared_frames: &'a [Frame],
+    pub(super) samples: &'a mut [TreeSample],
     /// Index in the whole sample array of `samples[0]`.
-    sample_base: u32,
+    pub(super) sample_base: u32,
 }
 
 impl Part<'_> {
@@ -162,7 +157,7 @@ impl Part<'_> {
         }
     }
 
-    fn slice(&mut self, node: &Node) -> &mut [TreeSample] {
+    pub(super) fn slice(&mut self, node: &Node) -> &mut [TreeSample] {
         let lo = (node.start - self.sample_base) as usize;
         &mut self.samples[lo..lo + node.count as usize]
     }
@@ -177,16 +172,27 @@ struct Job<'a> {
 }
 
 #[derive(Clone, Copy)]
-struct Builder {
+pub(super) struct Builder {
     params: TreeParams,
     /// Sums are taken relative to this point (the root's centre).
-    origin: DVec3,
+    pub(super) origin: DVec3,
     /// The L2 bound in absolute (squared) units.
     abs_error: f64,
     min_half: f32,
 }
 
 impl Builder {
+    /// The builder of a tree whose root is centred on `center`, over samples whose bounding
+    /// box has diagonal `diagonal`.
+    pub(super) fn new(params: &TreeParams, center: Vec3, diagonal: f32) -> Builder {
+        Builder {
+            params: *params,
+            origin: center.as_dvec3(),
+            abs_error: params.error * f64::from(diagonal).powi(2),
+            min_half: (0.5 * params.min_cell_size * f64::from(diagonal)) as f32,
+        }
+    }
+
     /// Processes node `first` and all its descendants, depth first. With `big` set (phase 1),
     /// nodes with at most [`FRONTIER`] samples are left unprocessed and returned.
     fn grow(&self, part: &mut Part, first: Pending, big: Option<&Threads>) -> Vec<Pending> {
@@ -206,45 +212,73 @@ impl Builder {
     /// Decides what node `i` (whose samples sum to `stats`) is: a leaf, a T-node, or split; and
     /// creates its children, returned with their sums.
     fn process(&self, part: &mut Part, i: usize, stats: &CellStats, threads: Option<&Threads>) -> Vec<Pending> {
+        self.classify(part, i, stats);
+        if self.error(part, &part.nodes[i], stats) <= self.threshold() {
+            return Vec::new();
+        }
+        self.split(part, i, threads)
+    }
+
+    /// Makes a V-node a T-node (with its frame) when the height-field indicator holds; called
+    /// once per node, when it is first processed.
+    pub(super) fn classify(&self, part: &mut Part, i: usize, stats: &CellStats) {
         let node = part.nodes[i];
-        let small_enough = match self.params.metric {
+        if node.kind != NodeKind::Volume || self.params.kind != TreeKind::VsTree {
+            return;
+        }
+        let slice = part.slice(&node);
+        let centroid = (stats.centroid() + self.origin).as_vec3();
+        let reach = reach(centroid, node.center, node.half);
+        if is_height_field(slice, centroid, stats.mean_normal(), reach, self.params.d_a, self.params.d_d) {
+            let f = frame(slice, stats, self.origin);
+            let index = (part.shared_frames.len() + part.frames.len()) as u32;
+            part.frames.push(f);
+            let n = &mut part.nodes[i];
+            n.kind = NodeKind::Transition;
+            n.frame = index;
+        }
+    }
+
+    /// The node's error in the units of [`Builder::threshold`]: for L2 the quadric at the
+    /// node's representative (absolute, squared), for L2,1 the normal deviation, for density
+    /// the sample count.
+    pub(super) fn error(&self, part: &Part, node: &Node, stats: &CellStats) -> f64 {
+        match self.params.metric {
             Metric::L2 => {
                 let frame = (node.kind == NodeKind::Surface).then(|| part.frame(node.frame));
-                let x = representative(&node, frame, stats, self.origin);
-                stats.quadric_at(x - self.origin) <= self.abs_error
+                let x = representative(node, frame, stats, self.origin);
+                stats.quadric_at(x - self.origin)
             }
-            Metric::L21 => stats.normal_deviation() <= self.params.error,
-            Metric::Density => stats.count as f64 <= self.params.error,
-        };
-        let splittable = node.count > 1 && u32::from(node.depth) < self.params.max_depth && node.half > self.min_half;
-        let split = !small_enough && splittable;
-
-        match node.kind {
-            NodeKind::Volume => {
-                let slice = part.slice(&node);
-                let centroid = (stats.centroid() + self.origin).as_vec3();
-                let reach = reach(centroid, node.center, node.half);
-                let flat = self.params.kind == TreeKind::VsTree
-                    && is_height_field(slice, centroid, stats.mean_normal(), reach, self.params.d_a, self.params.d_d);
-                if flat {
-                    let f = frame(slice, stats, self.origin);
-                    let index = (part.shared_frames.len() + part.frames.len()) as u32;
-                    part.frames.push(f);
-                    let n = &mut part.nodes[i];
-                    n.kind = NodeKind::Transition;
-                    n.frame = index;
-                    if split {
-                        let center = Vec3::new(f.square_center.x, f.square_center.y, 0.0);
-                        return self.split_quadrants(part, i, center, f.square_half, threads);
-                    }
-                } else if split {
-                    return self.split_octants(part, i, threads);
-                }
-            }
-            NodeKind::Surface if split => return self.split_quadrants(part, i, node.center, node.half, threads),
-            _ => {}
+            Metric::L21 => stats.normal_deviation(),
+            Metric::Density => stats.count as f64,
         }
-        Vec::new()
+    }
+
+    /// The bound on [`Builder::error`] below which a node is a leaf.
+    fn threshold(&self) -> f64 {
+        match self.params.metric {
+            Metric::L2 => self.abs_error,
+            Metric::L21 | Metric::Density => self.params.error,
+        }
+    }
+
+    /// Splits node `i` (already classified) into its octants or quadrants, unless it is too
+    /// small, too deep or a single sample; returns the children with their sums.
+    pub(super) fn split(&self, part: &mut Part, i: usize, threads: Option<&Threads>) -> Vec<Pending> {
+        let node = part.nodes[i];
+        let splittable = node.count > 1 && u32::from(node.depth) < self.params.max_depth && node.half > self.min_half;
+        if !splittable {
+            return Vec::new();
+        }
+        match node.kind {
+            NodeKind::Volume => self.split_octants(part, i, threads),
+            NodeKind::Transition => {
+                let f = *part.frame(node.frame);
+                let center = Vec3::new(f.square_center.x, f.square_center.y, 0.0);
+                self.split_quadrants(part, i, center, f.square_half, threads)
+            }
+            NodeKind::Surface => self.split_quadrants(part, i, node.center, node.half, threads),
+        }
     }
 
     fn split_octants(&self, part: &mut Part, i: usize, threads: Option<&Threads>) -> Vec<Pending> {
@@ -288,7 +322,7 @@ impl Builder {
     }
 }
 
-fn sum(samples: &[TreeSample], origin: DVec3) -> CellStats {
+pub(super) fn sum(samples: &[TreeSample], origin: DVec3) -> CellStats {
     let mut stats = CellStats::default();
     for s in samples {
         stats.add(s.position.as_dvec3() - origin, s.normal.as_dvec3());

@@ -6,6 +6,7 @@
 //! `samples[start .. start + count]`.
 
 mod build;
+mod fit;
 mod indicator;
 mod locate;
 mod partition;
@@ -16,6 +17,7 @@ use crate::quadric::CellStats;
 use glam::{DVec3, Vec2, Vec3};
 
 pub use build::build;
+pub use fit::fit;
 
 /// Which hierarchy to build.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -52,7 +52,7 @@ def test_registered(addon):
     assert hasattr(bpy.types, "VSTREE_PT_panel")
     ok, msg = addon.core.status()
     assert ok, msg
-    assert "libvstree 0.1.2" in msg
+    assert "libvstree 0.2.0" in msg
 
 
 def test_defaults_are_the_librarys(addon):
@@ -69,6 +69,10 @@ def test_defaults_are_the_librarys(addon):
     assert props["max_grid_depth"].default == reconstruct.max_grid_depth
     assert props["trim"].default == reconstruct.trim
     assert props["neighbours"].default == reconstruct.neighbours
+    op = bpy.ops.vstree.simplify.get_rna_type().properties
+    keep = {"auto": 0, "on": 1, "off": 2}
+    assert keep[op["keep_topology"].default] == simplify.keep_topology
+    assert op["ratio"].default == 0.0 and simplify.target_faces == 0  # both: the error bound decides
     settings = sidebar.bl_rna.properties
     assert settings["recon_error"].default == pytest.approx(reconstruct.error, rel=1e-6)
     assert settings["max_levels"].default == reconstruct.max_levels and settings["trim"].default == reconstruct.trim
@@ -96,6 +100,34 @@ def test_simplify_coarser_with_larger_error(scene):
     bpy.ops.vstree.simplify(error=1e-2)
     coarse = counts(bpy.context.active_object)
     assert coarse[0] < fine[0] < len(src.data.vertices)
+
+
+def test_simplify_to_a_ratio_closed_and_manifold(scene):
+    """A ratio like the Decimate modifier's: the count within 1%, a torus kept closed and
+    manifold with its genus by default; plain clustering when topology is off."""
+    bpy.ops.mesh.primitive_torus_add(major_segments=96, minor_segments=32)
+    src = bpy.context.active_object
+    triangles = 2 * len(src.data.polygons)  # quads, triangulated for the library
+    for ratio in (0.1, 0.02):
+        bpy.context.view_layer.objects.active = src
+        assert bpy.ops.vstree.simplify(ratio=ratio) == {'FINISHED'}
+        out = bpy.context.active_object
+        v, f = counts(out)
+        want = round(ratio * triangles)
+        assert abs(f - want) <= max(2, want // 100), (ratio, f, want)
+        links = edge_face_counts(out.data)
+        assert np.all(links == 2), (ratio, np.bincount(links))
+        assert v - len(links) + f == 0  # Euler characteristic of a torus: genus 1
+    bpy.context.view_layer.objects.active = src
+    assert bpy.ops.vstree.simplify(ratio=0.05, keep_topology='off') == {'FINISHED'}
+    want = round(0.05 * triangles)
+    assert abs(counts(bpy.context.active_object)[1] - want) <= max(2, want // 100)
+    # A cloud has no triangles to take a ratio of: a report, not a crash or an empty object.
+    sphere_cloud(500)
+    n_objects = len(bpy.data.objects)
+    with pytest.raises(RuntimeError, match="Error: VS-Tree: 'cloud' has no faces"):
+        bpy.ops.vstree.simplify(ratio=0.5)
+    assert len(bpy.data.objects) == n_objects
 
 
 def test_simplify_modifiers(scene):

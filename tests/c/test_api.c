@@ -351,6 +351,7 @@ static void default_parameters(void) {
   CHECK(p.tree_kind == VSTREE_TREE_KIND_VS_TREE && p.metric == VSTREE_METRIC_L2);
   CHECK(p.sampling == VSTREE_SAMPLING_VERTICES && p.threads == 0);
   CHECK(p.error > 0 && p.d_a >= 0 && p.d_d > 0 && p.max_depth >= 1 && p.min_cell_size >= 0);
+  CHECK(p.keep_topology == VSTREE_KEEP_TOPOLOGY_AUTO && p.target_faces == 0);
 }
 
 /* Every parameter field, each out of range in each way, is refused by name. */
@@ -377,6 +378,8 @@ SPOILER(threads_huge, threads, UINT32_MAX)
 SPOILER(cell_neg, min_cell_size, -1e-9)
 SPOILER(cell_one, min_cell_size, 1.0)
 SPOILER(cell_nan, min_cell_size, NAN)
+SPOILER(keep_big, keep_topology, 3)
+SPOILER(keep_neg, keep_topology, -1)
 static void density_half(vstree_simplify_params *q) {
   q->metric = VSTREE_METRIC_DENSITY;
   q->error = 0.5;
@@ -413,6 +416,8 @@ static void parameter_table(const vstree_mesh *mesh) {
       {"`min_cell_size`", VSTREE_STATUS_INVALID_PARAMETER, cell_neg},
       {"`min_cell_size`", VSTREE_STATUS_INVALID_PARAMETER, cell_one},
       {"`min_cell_size`", VSTREE_STATUS_INVALID_PARAMETER, cell_nan},
+      {"`keep_topology`", VSTREE_STATUS_INVALID_PARAMETER, keep_big},
+      {"`keep_topology`", VSTREE_STATUS_INVALID_PARAMETER, keep_neg},
       {"params->struct_size", VSTREE_STATUS_INVALID_ARGUMENT, size_zero},
       {"params->struct_size", VSTREE_STATUS_INVALID_ARGUMENT, size_short},
       {"newer vstree.h", VSTREE_STATUS_INVALID_ARGUMENT, size_long},
@@ -912,6 +917,64 @@ static void normal_estimation(const torus *tor, const vstree_mesh *cloud_no_norm
   cancel_at_every_report("vstree_estimate_normals", normals_call, cloud_no_normals, free_mesh);
 }
 
+/* Simplification to a size: the count within 1% (or 2 triangles), the torus closed with its
+ * genus (V = F / 2) unless plain clustering is asked for; a target the topology cannot reach
+ * gives the smallest closed mesh, not an empty one; a caller with the 0.1 struct (48 bytes)
+ * gets the error bound whatever lies after it. */
+static void sized_simplification(const vstree_mesh *mesh) {
+  const uint32_t targets[] = {1000, 230, 50, 1};
+  const int32_t modes[] = {VSTREE_KEEP_TOPOLOGY_AUTO, VSTREE_KEEP_TOPOLOGY_ON,
+                           VSTREE_KEEP_TOPOLOGY_OFF};
+  size_t i, m;
+  for (m = 0; m < sizeof modes / sizeof modes[0]; m++) {
+    for (i = 0; i < sizeof targets / sizeof targets[0]; i++) {
+      vstree_simplify_params p = vstree_simplify_params_default();
+      vstree_simplify_result *r = NULL;
+      const vstree_simplify_stats *s;
+      const vstree_mesh *out;
+      size_t f, v, slack = targets[i] / 100 > 2 ? targets[i] / 100 : 2;
+      uint32_t *tri;
+      p.target_faces = targets[i];
+      p.keep_topology = modes[m];
+      EXPECT(VSTREE_STATUS_OK, NULL, vstree_simplify(mesh, &p, NULL, NULL, &r));
+      if (r == NULL) continue;
+      s = vstree_simplify_result_get_stats(r);
+      out = vstree_simplify_result_get_mesh(r);
+      f = vstree_mesh_triangle_count(out);
+      v = vstree_mesh_vertex_count(out);
+      CHECK(s->target_faces == targets[i] && s->output_triangles == f);
+      CHECK(s->kept_topology == (modes[m] != VSTREE_KEEP_TOPOLOGY_OFF));
+      if (targets[i] == 1 && modes[m] != VSTREE_KEEP_TOPOLOGY_OFF) {
+        CHECK(f >= 14 && f <= 60); /* a torus needs 14 triangles at least */
+      } else if (targets[i] > 1) {
+        CHECK(f + slack >= targets[i] && f <= targets[i] + slack);
+      }
+      CHECK(f > 0);
+      if (modes[m] != VSTREE_KEEP_TOPOLOGY_OFF) {
+        tri = (uint32_t *)malloc(3 * f * sizeof *tri);
+        EXPECT(VSTREE_STATUS_OK, NULL, vstree_mesh_copy_triangles(out, tri, 3 * f));
+        CHECK(watertight(tri, f, v));
+        CHECK(2 * v == f);
+        free(tri);
+      }
+      vstree_simplify_result_free(r);
+    }
+  }
+  {
+    vstree_simplify_params p = vstree_simplify_params_default();
+    vstree_simplify_result *r = NULL;
+    p.struct_size = 48;
+    p.target_faces = 50;
+    p.keep_topology = 99;
+    EXPECT(VSTREE_STATUS_OK, NULL, vstree_simplify(mesh, &p, NULL, NULL, &r));
+    if (r != NULL) {
+      const vstree_simplify_stats *s = vstree_simplify_result_get_stats(r);
+      CHECK(s->target_faces == 0 && s->kept_topology == 1 && s->output_triangles > 100);
+      vstree_simplify_result_free(r);
+    }
+  }
+}
+
 int main(int argc, char **argv) {
   torus t = make_torus(48, 24, 0.2f);
   vstree_mesh *mesh, *cloud, *cloud_no_normals, *mesh_no_normals;
@@ -934,6 +997,7 @@ int main(int argc, char **argv) {
   trees(mesh);
   reconstruction(cloud, cloud_no_normals);
   normal_estimation(&t, cloud_no_normals, mesh_no_normals);
+  sized_simplification(mesh);
 
   vstree_mesh_free(mesh);
   vstree_mesh_free(cloud);

@@ -582,6 +582,15 @@ SIMPLIFY_PARAM(simplify_min_cell_neg, min_cell_size, -1e-9)
 SIMPLIFY_PARAM(simplify_min_cell_one, min_cell_size, 1.0)
 SIMPLIFY_PARAM(simplify_min_cell_nan, min_cell_size, NAN)
 SIMPLIFY_PARAM(simplify_min_cell_inf, min_cell_size, INFINITY)
+SIMPLIFY_PARAM(simplify_keep_topology_3, keep_topology, 3)
+SIMPLIFY_PARAM(simplify_keep_topology_neg, keep_topology, -1)
+SIMPLIFY_PARAM(simplify_target_above_input, target_faces, 577)
+SIMPLIFY_PARAM(simplify_target_huge, target_faces, UINT32_MAX)
+CALL(simplify_target_on_cloud) {
+  vstree_simplify_params p = vstree_simplify_params_default();
+  p.target_faces = 10;
+  return simplify_with(g_cloud, &p);
+}
 CALL(simplify_density_half) {
   vstree_simplify_params p = vstree_simplify_params_default();
   p.metric = VSTREE_METRIC_DENSITY;
@@ -949,7 +958,14 @@ typedef struct bad_case {
 
 /* ---- results that would be empty or wrong, files that are not regular, outputs that must not
  * be replaced ---- */
-SIMPLIFY_PARAM(simplify_error_whole_model, error, 100.0)
+/* Plain clustering: with the topology kept (the default for this closed torus) the smallest
+ * closed torus is the result instead. */
+CALL(simplify_error_whole_model) {
+  vstree_simplify_params p = vstree_simplify_params_default();
+  p.error = 100.0;
+  p.keep_topology = VSTREE_KEEP_TOPOLOGY_OFF;
+  return simplify_with(g_mesh, &p);
+}
 CALL(simplify_l21_above_4) {
   vstree_simplify_params p = vstree_simplify_params_default();
   p.metric = VSTREE_METRIC_L21;
@@ -1273,17 +1289,17 @@ static const bad_case g_cases[] = {
         "vstree_simplify: `params`: pointer is misaligned"),
     ROW(simplify_size_zero, INVALID_ARGUMENT,
         "vstree_simplify: `params->struct_size`: 0 is not a size of vstree_simplify_params this "
-        "library knows (48 to 48): initialise the struct with its _default() function"),
+        "library knows (48 to 56): initialise the struct with its _default() function"),
     ROW(simplify_size_short, INVALID_ARGUMENT,
         "vstree_simplify: `params->struct_size`: 4 is not a size of vstree_simplify_params this "
-        "library knows (48 to 48): initialise the struct with its _default() function"),
+        "library knows (48 to 56): initialise the struct with its _default() function"),
     ROW(simplify_size_one_more, INVALID_ARGUMENT,
-        "vstree_simplify: `params->struct_size`: 49 is not a size of vstree_simplify_params this "
-        "library knows (48 to 48): the program was compiled against a newer vstree.h than this "
+        "vstree_simplify: `params->struct_size`: 57 is not a size of vstree_simplify_params this "
+        "library knows (48 to 56): the program was compiled against a newer vstree.h than this "
         "library"),
     ROW(simplify_size_huge, INVALID_ARGUMENT,
         "vstree_simplify: `params->struct_size`: 4294967295 is not a size of "
-        "vstree_simplify_params this library knows (48 to 48): the program was compiled against "
+        "vstree_simplify_params this library knows (48 to 56): the program was compiled against "
         "a newer vstree.h than this library"),
     ROW(simplify_tree_kind_99, INVALID_PARAMETER,
         "vstree_simplify: parameter `tree_kind`: 99: must be one of 0 "
@@ -1345,6 +1361,20 @@ static const bad_case g_cases[] = {
         "vstree_simplify: parameter `min_cell_size`: NaN: must be in [0, 1)"),
     ROW(simplify_min_cell_inf, INVALID_PARAMETER,
         "vstree_simplify: parameter `min_cell_size`: inf: must be in [0, 1)"),
+    ROW(simplify_keep_topology_3, INVALID_PARAMETER,
+        "vstree_simplify: parameter `keep_topology`: 3: must be one of 0 "
+        "(VSTREE_KEEP_TOPOLOGY_AUTO), 1 (VSTREE_KEEP_TOPOLOGY_ON), 2 (VSTREE_KEEP_TOPOLOGY_OFF)"),
+    ROW(simplify_keep_topology_neg, INVALID_PARAMETER,
+        "vstree_simplify: parameter `keep_topology`: -1: must be one of 0 "
+        "(VSTREE_KEEP_TOPOLOGY_AUTO), 1 (VSTREE_KEEP_TOPOLOGY_ON), 2 (VSTREE_KEEP_TOPOLOGY_OFF)"),
+    ROW(simplify_target_above_input, INVALID_PARAMETER,
+        "vstree_simplify: parameter `target_faces`: 577: more than the input's 576 triangles"),
+    ROW(simplify_target_huge, INVALID_PARAMETER,
+        "vstree_simplify: parameter `target_faces`: 4294967295: more than the input's 576 "
+        "triangles"),
+    ROW(simplify_target_on_cloud, INVALID_PARAMETER,
+        "vstree_simplify: parameter `target_faces`: 10 triangles asked of a point cloud: a target "
+        "needs a mesh (use the error bound)"),
     ROW(simplify_density_half, INVALID_PARAMETER,
         "vstree_simplify: parameter `error`: 0.5 samples per cell: must be at least 1"),
     ROW(simplify_l21_zero, INVALID_PARAMETER,
@@ -1356,10 +1386,10 @@ static const bad_case g_cases[] = {
         "vstree_tree_build: invalid input: the point cloud has no normals (estimate them first)"),
     ROW(tree_size_zero, INVALID_ARGUMENT,
         "vstree_tree_build: `params->struct_size`: 0 is not a size of vstree_simplify_params "
-        "this library knows (48 to 48): initialise the struct with its _default() function"),
+        "this library knows (48 to 56): initialise the struct with its _default() function"),
     ROW(tree_size_long, INVALID_ARGUMENT,
         "vstree_tree_build: `params->struct_size`: 4096 is not a size of vstree_simplify_params "
-        "this library knows (48 to 48): the program was compiled against a newer vstree.h than "
+        "this library knows (48 to 56): the program was compiled against a newer vstree.h than "
         "this library"),
     ROW(tree_tree_kind_99, INVALID_PARAMETER,
         "vstree_tree_build: parameter `tree_kind`: 99: must be one of 0 "

@@ -102,6 +102,36 @@ def test_simplify_options():
         print(f"  {kw}: {out['output_vertices']} v / {out['output_triangles']} f")
 
 
+def test_simplify_to_a_size_closed_and_manifold():
+    """The face count (or fraction) like the quadric filter's, the sphere kept closed and
+    manifold by default, plain clustering when topology is off, and bad sizes refused."""
+    ms = pymeshlab.MeshSet()
+    sphere(ms)
+    src_id = ms.current_mesh_id()
+    for kw, want in ((dict(target_faces=500), 500), (dict(target_faces=100), 100),
+                     (dict(target_perc=0.1), 512), (dict(target_faces=900, target_perc=0.02), 102)):
+        ms.set_current_mesh(src_id)
+        out = ms.apply_filter(SIMPLIFY, **kw)
+        m = ms.current_mesh()
+        t = topo(ms)
+        print(f"  {kw}: {m.face_number()} faces, {t['boundary_edges']} border edges, genus {t['genus']}")
+        assert abs(m.face_number() - want) <= max(2, want // 100), (kw, m.face_number())
+        assert out["kept_topology"] == 1 and t["boundary_edges"] == 0 and t["genus"] == 0, (kw, t)
+        assert t["non_two_manifold_edges"] == 0 and t["non_two_manifold_vertices"] == 0, (kw, t)
+    ms.set_current_mesh(src_id)
+    out = ms.apply_filter(SIMPLIFY, target_faces=300, keep_topology="Off")
+    assert out["kept_topology"] == 0 and abs(ms.current_mesh().face_number() - 300) <= 3
+    # Below what a sphere allows: a tetrahedron, not an empty layer.
+    ms.set_current_mesh(src_id)
+    ms.apply_filter(SIMPLIFY, target_faces=1)
+    assert ms.current_mesh().face_number() == 4
+    bad = pymeshlab.MeshSet()
+    sphere(bad)
+    expect_error(bad, SIMPLIFY, "more than the input's 5120 triangles", target_faces=6000)
+    expect_error(bad, SIMPLIFY, "'Percentage reduction' is 1.5", target_perc=1.5)
+    expect_error(bad, SIMPLIFY, "'Target number of faces' is -3", target_faces=-3)
+
+
 def percentage(value):
     """A percentage of the bounding-box diagonal, in either pymeshlab's spelling."""
     return (getattr(pymeshlab, "PercentageValue", None) or pymeshlab.Percentage)(value)
@@ -273,6 +303,9 @@ def test_defaults_are_the_librarys():
         assert abs(got["error"] - simplify.error) <= 1e-6 * simplify.error, (name, got["error"])
         assert abs(got["d_a"] - simplify.d_a) < 1e-6 and abs(got["d_d"] - simplify.d_d) < 1e-6, (name, got)
         assert got["max_depth"] == simplify.max_depth, (name, got)
+    got = ms.filter_parameter_values(SIMPLIFY)
+    assert got["target_faces"] == simplify.target_faces and got["target_perc"] == 0, got
+    assert got["keep_topology"] == simplify.keep_topology, got
     got = ms.filter_parameter_values(RECONSTRUCT)
     assert abs(got["error"] - reconstruct.error) <= 1e-6 * reconstruct.error, got["error"]
     assert got["levels"] == reconstruct.max_levels and got["trim"] == reconstruct.trim, got

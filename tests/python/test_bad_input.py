@@ -227,6 +227,32 @@ PARAMETER_CASES = [
          "vstree_simplify: parameter `metric`: 3: " + ENUM_METRIC),
     case("simplify-sampling-number", simplify_with(sampling=2), vstree.VstreeError, BAD,
          "vstree_simplify: parameter `sampling`: 2: " + ENUM_SAMPLING),
+    # simplify to a size: a count the input has, a ratio in (0, 1], meshes only.
+    case("simplify-target-above-input", simplify_with(target_faces=257), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `target_faces`: 257: more than the input's 256 triangles"),
+    case("simplify-target-on-a-cloud", lambda c: vstree.simplify(vstree.Mesh(CLOUD, None, CLOUD), target_faces=10),
+         vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `target_faces`: 10 triangles asked of a point cloud: a target needs a mesh "
+         "(use the error bound)"),
+    case("simplify-target-negative", simplify_with(target_faces=-1), vstree.VstreeError, BAD,
+         "vstree.simplify: parameter `target_faces`: -1 is out of range for the C field (uint32)"),
+    case("simplify-keep_topology-number", simplify_with(keep_topology=3), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `keep_topology`: 3: must be one of 0 (VSTREE_KEEP_TOPOLOGY_AUTO), "
+         "1 (VSTREE_KEEP_TOPOLOGY_ON), 2 (VSTREE_KEEP_TOPOLOGY_OFF)"),
+    case("simplify-keep_topology-unknown-name", simplify_with(keep_topology="sometimes"), ValueError, None,
+         "vstree.simplify: parameter `keep_topology`: 'sometimes' is not one of 'auto', 'off', 'on'"),
+    case("simplify-ratio-zero", simplify_with(ratio=0), vstree.VstreeError, BAD,
+         "vstree.simplify: parameter `ratio`: 0: must be in (0, 1], a fraction of the triangles"),
+    case("simplify-ratio-above-one", simplify_with(ratio=1.5), vstree.VstreeError, BAD,
+         "vstree.simplify: parameter `ratio`: 1.5: must be in (0, 1], a fraction of the triangles"),
+    case("simplify-ratio-nan", simplify_with(ratio=NAN), vstree.VstreeError, BAD,
+         "vstree.simplify: parameter `ratio`: nan: must be in (0, 1], a fraction of the triangles"),
+    case("simplify-ratio-string", simplify_with(ratio="half"), TypeError, None,
+         "vstree.simplify: parameter `ratio`: must be a real number, not 'half' (str)"),
+    case("simplify-ratio-and-target", simplify_with(ratio=0.5, target_faces=10), TypeError, None,
+         "vstree.simplify: give `ratio` or `target_faces`, not both"),
+    case("simplify-ratio-on-a-cloud", lambda c: vstree.simplify(vstree.Mesh(CLOUD, None, CLOUD), ratio=0.5),
+         vstree.VstreeError, BAD, "vstree.simplify: parameter `ratio`: the input is a point cloud: a ratio needs triangles"),
     # simplify: what the binding refuses before C (names, types, C field widths).
     case("simplify-tree_kind-quadtree", simplify_with(tree_kind="quadtree"), ValueError, None,
          "vstree.simplify: parameter `tree_kind`: 'quadtree' is not one of 'octree', 'vstree'"),
@@ -254,7 +280,7 @@ PARAMETER_CASES = [
          "vstree.simplify: parameter `error`: must be a real number, not None (NoneType)"),
     case("simplify-unknown-parameter", simplify_with(eror=1e-3), TypeError, None,
          "vstree.simplify: unknown parameter 'eror' (the parameters are error, tree_kind, metric, "
-         "sampling, d_a, d_d, max_depth, threads, min_cell_size)"),
+         "sampling, d_a, d_d, max_depth, threads, min_cell_size, keep_topology, target_faces)"),
     # Tree: the same parameters, its own function name.
     case("tree-tree_kind-quadtree", tree_with(tree_kind="quadtree"), ValueError, None,
          "vstree.Tree: parameter `tree_kind`: 'quadtree' is not one of 'octree', 'vstree'"),

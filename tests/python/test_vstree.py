@@ -64,7 +64,7 @@ def test_arrays_round_trip(shape):
 
 def test_simplify_gives_a_smaller_mesh_and_statistics(shape):
     p, t, _ = shape
-    result = vstree.simplify(vstree.Mesh(p, t), error=2e-3)
+    result = vstree.simplify(vstree.Mesh(p, t), error=2e-3, keep_topology="off")
     out, s = result.mesh, result.stats
     assert 10 < out.vertex_count < len(p)
     assert s["output_vertices"] == out.vertex_count and s["output_triangles"] == out.triangle_count
@@ -76,6 +76,24 @@ def test_simplify_gives_a_smaller_mesh_and_statistics(shape):
     assert coarser.vertex_count < out.vertex_count
     octree = vstree.simplify(vstree.Mesh(p, t), error=2e-3, tree_kind="octree").stats
     assert octree["t_nodes"] == 0
+
+
+def test_simplify_to_a_size_keeps_a_closed_torus_closed(shape):
+    p, t, _ = shape
+    mesh = vstree.Mesh(p, t)
+    for target in (len(t) // 10, len(t) // 50, 100):
+        for keep in ("auto", "on", True):
+            out, s = vstree.simplify(mesh, target_faces=target, keep_topology=keep)
+            assert abs(out.triangle_count - target) <= max(2, target // 100), (target, out.triangle_count)
+            assert s["kept_topology"] == 1 and s["target_faces"] == target
+            assert euler_genus(out) == (1, True)
+        out, s = vstree.simplify(mesh, target_faces=target, keep_topology=False)
+        assert s["kept_topology"] == 0 and abs(out.triangle_count - target) <= max(2, target // 100)
+    out, s = vstree.simplify(mesh, ratio=0.05)
+    assert s["target_faces"] == round(0.05 * len(t)) and euler_genus(out) == (1, True)
+    # Below what a torus allows: the smallest closed torus the collapses reach, never empty.
+    out, _ = vstree.simplify(mesh, target_faces=1)
+    assert 14 <= out.triangle_count <= 60 and euler_genus(out) == (1, True)
 
 
 def test_point_clouds_with_normals_simplify_to_points(shape):

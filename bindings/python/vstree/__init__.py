@@ -21,6 +21,7 @@ so threads can simplify different meshes at once.
 """
 
 import ctypes
+import numbers
 import operator
 import os
 from collections import namedtuple
@@ -332,12 +333,14 @@ _METRICS = {"l2": 0, "l21": 1, "density": 2}
 _SAMPLINGS = {"vertices": 0, "faces": 1, "face_centers": 1}
 _ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
 _CLOSURES = {"auto": 0, "closed": 1, "open": 2}
+_KEEP_TOPOLOGY = {"auto": 0, "on": 1, "off": 2}
 _ENUMS = {
     "tree_kind": _TREE_KINDS,
     "metric": _METRICS,
     "sampling": _SAMPLINGS,
     "orient": _ORIENTATIONS,
     "closure": _CLOSURES,
+    "keep_topology": _KEEP_TOPOLOGY,
 }
 _C_INTEGERS = {ctypes.c_uint32: ("uint32", 0, 2**32 - 1), ctypes.c_int32: ("int32", -(2**31), 2**31 - 1)}
 
@@ -362,6 +365,8 @@ def _set_options(who, p, options, fields):
             raise TypeError("%s: unknown parameter %r (the parameters are %s)" % (who, key, ", ".join(fields)))
         c_type = types[key]
         expected = "an integer"
+        if key == "keep_topology" and isinstance(value, bool):
+            value = "on" if value else "off"
         if key in _ENUMS:
             names = ", ".join(repr(n) for n in sorted(_ENUMS[key]))
             expected = "one of %s or an integer" % names
@@ -386,7 +391,19 @@ def _set_options(who, p, options, fields):
     return p
 
 
-_SIMPLIFY_FIELDS = ("error", "tree_kind", "metric", "sampling", "d_a", "d_d", "max_depth", "threads", "min_cell_size")
+_SIMPLIFY_FIELDS = (
+    "error",
+    "tree_kind",
+    "metric",
+    "sampling",
+    "d_a",
+    "d_d",
+    "max_depth",
+    "threads",
+    "min_cell_size",
+    "keep_topology",
+    "target_faces",
+)
 
 
 def _params(who, options):
@@ -432,22 +449,48 @@ class _Progress:
         _check(status)
 
 
+def _target_from_ratio(ratio, params, triangles):
+    """``target_faces`` for a fraction ``ratio`` of ``triangles``."""
+    who = "vstree.simplify"
+    if "target_faces" in params:
+        raise TypeError("%s: give `ratio` or `target_faces`, not both" % who)
+    if isinstance(ratio, bool) or not isinstance(ratio, numbers.Real):
+        raise TypeError("%s: parameter `ratio`: must be a real number, not %r (%s)" % (who, ratio, type(ratio).__name__))
+    if not 0.0 < float(ratio) <= 1.0:
+        raise VstreeError(
+            Status.INVALID_PARAMETER, "%s: parameter `ratio`: %r: must be in (0, 1], a fraction of the triangles" % (who, ratio)
+        )
+    if triangles == 0:
+        raise VstreeError(
+            Status.INVALID_PARAMETER, "%s: parameter `ratio`: the input is a point cloud: a ratio needs triangles" % who
+        )
+    return max(1, int(round(float(ratio) * triangles)))
+
+
 SimplifyResult = namedtuple("SimplifyResult", ["mesh", "stats"])
 SimplifyResult.__doc__ = "The simplified :class:`Mesh` and a dict of statistics."
 
 
-def simplify(mesh, progress=None, **params):
+def simplify(mesh, progress=None, ratio=None, **params):
     """Simplifies ``mesh`` (a :class:`Mesh`, or a point cloud with normals) by clustering in a
     VS-Tree. Parameters are the C struct's fields: ``error`` (L2: relative to the squared
     bounding-box diagonal; default 1e-3), ``tree_kind`` ("vstree" | "octree"), ``metric``
     ("l2" | "l21" | "density"), ``sampling`` ("vertices" | "faces"), ``d_a``, ``d_d``,
-    ``max_depth``, ``threads`` (0 = all cores), ``min_cell_size``.
+    ``max_depth``, ``threads`` (0 = all cores), ``min_cell_size``, ``keep_topology``
+    ("auto": kept for closed 2-manifolds, the default; "on" or True; "off" or False: plain
+    clustering), ``target_faces`` (triangles wanted instead of the bound; 0 = the bound).
+
+    ``ratio`` (in (0, 1]) asks for that fraction of the input's triangles instead of
+    ``target_faces`` (rounded, at least 1). Below what the topology allows, the result is the
+    smallest mesh reachable: ``stats["output_triangles"]`` says how many.
 
     ``progress(fraction, stage)`` is called on this thread; returning False cancels
     (:class:`CancelledError`). Returns ``SimplifyResult(mesh, stats)``.
     """
-    p = _params("vstree.simplify", params)
     handle = _mesh_handle("vstree.simplify", mesh)
+    if ratio is not None:
+        params["target_faces"] = _target_from_ratio(ratio, params, lib.vstree_mesh_triangle_count(handle))
+    p = _params("vstree.simplify", params)
     cb = _Progress("vstree.simplify", progress)
     result = ctypes.c_void_p()
     cb.check(lib.vstree_simplify(handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))

@@ -77,6 +77,8 @@ class SimplifyParams(Structure):
         ("max_depth", c_uint32),
         ("threads", c_uint32),
         ("min_cell_size", c_double),
+        ("keep_topology", c_int32),
+        ("target_faces", c_uint32),
     ]
 
 
@@ -102,6 +104,8 @@ class SimplifyStats(Structure):
         ("seconds_tree", c_double),
         ("seconds_cluster", c_double),
         ("seconds_total", c_double),
+        ("kept_topology", c_uint32),
+        ("target_faces", c_uint32),
     ]
 
 

@@ -76,6 +76,13 @@ LABEL_KINDS = [
 ]
 
 
+KEEP_TOPOLOGY = [
+    ('auto', "Auto", "Keep it when the mesh is closed and manifold; plain clustering otherwise"),
+    ('on', "On", "Merge clusters only by collapses that keep the topology (borders stay manifold)"),
+    ('off', "Off", "Plain vertex clustering: faster, may fuse close sheets"),
+]
+
+
 # The library's defaults (vstree_simplify_params_default(), vstree_reconstruct_params_default()).
 # Properties are declared when the add-on registers, before the library is loaded (on first use,
 # so that enabling never fails), hence the copies; tests/blender checks that they agree.
@@ -225,13 +232,33 @@ class VSTREE_OT_simplify(_Worker, bpy.types.Operator):
         description="Replace the object's mesh (undoable) instead of adding a new object",
     )
     threads: IntProperty(name="Threads", default=0, min=0, max=1024, description="Worker threads (0 = all cores)")
+    ratio: FloatProperty(
+        name="Ratio",
+        default=0.0,
+        min=0.0,
+        max=1.0,
+        subtype='FACTOR',
+        description="Fraction of the triangles to keep, like the Decimate modifier's ratio (the count "
+        "is met within one triangle); 0 = use the error bound",
+    )
+    keep_topology: EnumProperty(
+        name="Keep Topology",
+        items=KEEP_TOPOLOGY,
+        default='auto',
+        description="Keep a closed mesh closed and manifold with its genus",
+    )
 
     @classmethod
     def poll(cls, context):
         return _is_mesh(context)
 
     def _params(self):
-        return dict(error=self.error, tree_kind=self.tree_kind, metric=self.metric, threads=self.threads)
+        p = dict(error=self.error, tree_kind=self.tree_kind, metric=self.metric, threads=self.threads,
+                 keep_topology=self.keep_topology)
+        if self.ratio > 0.0:
+            del p["error"]
+            p["ratio"] = self.ratio
+        return p
 
     def _read(self, context, ob):
         return core.read_simplify(context, ob, self.apply_modifiers)
@@ -251,9 +278,9 @@ class VSTREE_OT_simplify(_Worker, bpy.types.Operator):
             context.view_layer.objects.active = target
         self.report(
             {'INFO'},
-            "VS-Tree: %d vertices, %d triangles (%d clusters, %.2f s)"
+            "VS-Tree: %d vertices, %d triangles (%d clusters, topology %s, %.2f s)"
             % (len(target.data.vertices), len(target.data.polygons), stats.get("clusters", 0),
-               stats.get("seconds_total", 0.0)),
+               "kept" if stats.get("kept_topology") else "not kept", stats.get("seconds_total", 0.0)),
         )
         return {'FINISHED'}
 

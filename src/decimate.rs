@@ -1,0 +1,342 @@
+//! Quadric edge collapse (Garland & Heckbert 1997) down to a triangle count, under the link
+//! condition of [`crate::collapse`]: the cheapest edge goes first, its vertices merge at the
+//! point that minimises their summed quadric, and a collapse that would change the topology or
+//! fold a face over is skipped. The quadrics are the clusters' (their samples' tangent planes),
+//! so the cost is the distance to the input surface, not to the clustered mesh. Borders shrink
+//! by collapses along them that keep them manifold, with a plane through each border edge
+//! across the surface added to its ends' quadrics (Garland & Heckbert's border constraint), so
+//! a border keeps its course. Used after clustering, to bring a simplification to the exact
+//! size asked for.
+
+use crate::collapse::Collapser;
+use crate::linalg::Sym3;
+use crate::mesh::Mesh;
+use crate::quadric::CellStats;
+use glam::DVec3;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// A collapse is refused when it would turn one of the faces around it by more than the angle
+/// with this cosine (unitless; 0 = a right angle): beyond that the face folds over its
+/// neighbours, which a quadric cannot see because it only measures distances to planes.
+const FOLD_COSINE: f64 = 0.0;
+
+/// A candidate collapse: `gone` merges into `keep` at `position`, for `cost`; `versions` are
+/// the two vertices' versions when it was planned (stale once either changes).
+struct Candidate {
+    cost: f64,
+    gone: u32,
+    keep: u32,
+    position: DVec3,
+    versions: [u32; 2],
+    /// Along a border edge.
+    border: bool,
+}
+
+impl PartialEq for Candidate {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Candidate {}
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Candidate {
+    /// Reversed, so the heap's top is the cheapest; ties by vertex indices, so the order is
+    /// always the same.
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.cost.total_cmp(&self.cost).then_with(|| (other.gone, other.keep).cmp(&(self.gone, self.keep)))
+    }
+}
+
+/// The state of a decimation.
+struct Decimator {
+    collapser: Collapser,
+    /// Positions relative to the quadrics' origin.
+    positions: Vec<DVec3>,
+    quadrics: Vec<CellStats>,
+    versions: Vec<u32>,
+    heap: BinaryHeap<Candidate>,
+}
+
+/// Collapses edges of `mesh` (proper triangles, every vertex used) until it has at most
+/// `target + 1` triangles (an interior collapse removes two, a border one one), or no allowed
+/// collapse is left.
+/// `quadrics[v]` is vertex v's quadric, over positions relative to `origin` (in the mesh's
+/// frame). Returns the mesh, with the input's winding, and the input vertex each output vertex
+/// is.
+pub(crate) fn decimate(mesh: &Mesh, quadrics: Vec<CellStats>, origin: DVec3, target: usize) -> (Mesh, Vec<u32>) {
+    let n = mesh.positions.len();
+    debug_assert_eq!(quadrics.len(), n);
+    let mut d = Decimator {
+        collapser: Collapser::new(mesh),
+        positions: mesh.positions.iter().map(|p| p.as_dvec3() - origin).collect(),
+        quadrics,
+        versions: vec![0; n],
+        heap: BinaryHeap::new(),
+    };
+    let mut faces = mesh.triangles.len();
+    let mut used = vec![false; n];
+    for &v in mesh.triangles.iter().flatten() {
+        used[v as usize] = true;
+    }
+    for (v, _) in used.iter().enumerate().filter(|(_, &u)| !u) {
+        d.collapser.remove_vertex(v);
+    }
+    d.add_border_planes(mesh);
+    while faces >= target + 2 {
+        d.seed(mesh);
+        let before = faces;
+        while faces >= target + 2 {
+            let Some(c) = d.heap.pop() else { break };
+            if d.versions[c.gone as usize] != c.versions[0] || d.versions[c.keep as usize] != c.versions[1] {
+                continue;
+            }
+            let allowed = if c.border {
+                d.collapser.can_collapse_border(c.gone, c.keep)
+            } else {
+                d.collapser.can_collapse(c.gone, c.keep)
+            };
+            if !allowed || d.folds(c.gone, c.keep, c.position) {
+                continue;
+            }
+            faces -= if c.border { 1 } else { 2 };
+            d.apply(c);
+        }
+        if faces == before {
+            break; // a whole pass over every edge found nothing to collapse
+        }
+    }
+    let identity: Vec<u32> = (0..n as u32).collect();
+    let (mut out, kept) = d.collapser.finish(&identity);
+    for (p, &v) in out.positions.iter_mut().zip(&kept) {
+        *p = (d.positions[v as usize] + origin).as_vec3();
+    }
+    (out, kept)
+}
+
+impl Decimator {
+    /// Fills the heap with every live edge (once each).
+    fn seed(&mut self, mesh: &Mesh) {
+        self.heap.clear();
+        let mut edges: Vec<(u32, u32)> = Vec::new();
+        for v in 0..mesh.positions.len() as u32 {
+            if !self.collapser.is_alive(v) {
+                continue;
+            }
+            for t in self.collapser.faces_around(v) {
+                edges.extend(t.iter().filter(|&&w| w > v).map(|&w| (v, w)));
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        for (u, v) in edges {
+            self.plan(u, v);
+        }
+    }
+
+    /// Queues the best collapse of edge u-v, if one is allowed: a border vertex stays where
+    /// it is (so borders keep their shape), along a border the cheaper end stays; otherwise
+    /// the merged quadric's minimiser (the middle where it has none) or either end, whichever
+    /// costs least (Garland & Heckbert's choice).
+    fn plan(&mut self, u: u32, v: u32) {
+        let (bu, bv) = (self.collapser.is_border(u), self.collapser.is_border(v));
+        let border = bu && bv;
+        if border && self.collapser.edge_faces(u, v) != 1 {
+            return; // an interior edge between border vertices: it would pinch the border
+        }
+        let mut q = self.quadrics[u as usize];
+        q.merge(&self.quadrics[v as usize]);
+        let (pu, pv) = (self.positions[u as usize], self.positions[v as usize]);
+        let (gone, keep, position) = if border {
+            if q.quadric_at(pu) <= q.quadric_at(pv) {
+                (v, u, pu)
+            } else {
+                (u, v, pv)
+            }
+        } else if bu {
+            (v, u, pu)
+        } else if bv {
+            (u, v, pv)
+        } else {
+            // Where the quadric pins no single point (flat or creased), the middle or an end.
+            let x = q.quadric_minimizer_if_regular().unwrap_or(0.5 * (pu + pv));
+            let best = [x, pu, pv].into_iter().min_by(|a, b| q.quadric_at(*a).total_cmp(&q.quadric_at(*b)));
+            (u.max(v), u.min(v), best.unwrap_or(x))
+        };
+        let versions = [self.versions[gone as usize], self.versions[keep as usize]];
+        self.heap.push(Candidate { cost: q.quadric_at(position), gone, keep, position, versions, border });
+    }
+
+    /// Adds to the quadric of each border edge's ends the plane through the edge across its
+    /// face, weighted like one vertex's samples (the mean count of samples per vertex), so a
+    /// border that moves costs as much as a surface that does.
+    fn add_border_planes(&mut self, mesh: &Mesh) {
+        if !self.collapser.has_border() {
+            return; // closed: nothing to sort out
+        }
+        let n = self.quadrics.len().max(1) as f64;
+        let weight = self.quadrics.iter().map(|q| q.count as f64).sum::<f64>() / n;
+        let mut edges: Vec<((u32, u32), u32)> = Vec::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                edges.push(((a.min(b), a.max(b)), t as u32));
+            }
+        }
+        edges.sort_unstable();
+        for (i, &((a, b), t)) in edges.iter().enumerate() {
+            let alone = (i == 0 || edges[i - 1].0 != (a, b)) && edges.get(i + 1).is_none_or(|e| e.0 != (a, b));
+            if !alone {
+                continue;
+            }
+            let [x, y, z] = mesh.triangles[t as usize].map(|v| self.positions[v as usize]);
+            let normal = (y - x).cross(z - x);
+            let (pa, pb) = (self.positions[a as usize], self.positions[b as usize]);
+            let across = (pb - pa).cross(normal).normalize_or_zero();
+            if across == DVec3::ZERO {
+                continue;
+            }
+            let d = across.dot(pa);
+            for v in [a, b] {
+                let q = &mut self.quadrics[v as usize];
+                q.nn.add(&Sym3::outer(across).scaled(weight));
+                q.b += across * (d * weight);
+                q.c += d * d * weight;
+            }
+        }
+    }
+
+    /// Whether moving the ends of edge gone-keep to `position` would turn a surviving face by
+    /// more than [`FOLD_COSINE`] allows (or make it degenerate).
+    fn folds(&self, gone: u32, keep: u32, position: DVec3) -> bool {
+        let p = |v: u32| if v == gone || v == keep { position } else { self.positions[v as usize] };
+        let old = |v: u32| self.positions[v as usize];
+        for x in [gone, keep] {
+            for t in self.collapser.faces_around(x) {
+                if t.contains(&gone) && t.contains(&keep) {
+                    continue; // dies with the edge
+                }
+                let before = (old(t[1]) - old(t[0])).cross(old(t[2]) - old(t[0]));
+                let after = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
+                let scale = before.length() * after.length();
+                if scale == 0.0 || before.dot(after) <= FOLD_COSINE * scale {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    fn apply(&mut self, c: Candidate) {
+        let q = self.quadrics[c.gone as usize];
+        self.quadrics[c.keep as usize].merge(&q);
+        self.positions[c.keep as usize] = c.position;
+        self.versions[c.gone as usize] += 1;
+        self.versions[c.keep as usize] += 1;
+        self.collapser.merge(c.gone, c.keep);
+        let mut around: Vec<u32> =
+            self.collapser.faces_around(c.keep).flat_map(|t| t.into_iter()).filter(|&w| w != c.keep).collect();
+        around.sort_unstable();
+        around.dedup();
+        for w in around {
+            self.plan(c.keep, w);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shapes;
+    use crate::topology::analyze;
+
+    /// Each vertex's quadric: the planes of its faces (unit normals, as samples would give).
+    fn face_quadrics(mesh: &Mesh) -> Vec<CellStats> {
+        let mut q = vec![CellStats::default(); mesh.positions.len()];
+        for t in &mesh.triangles {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize].as_dvec3());
+            let n = (b - a).cross(c - a).normalize();
+            for &v in t {
+                q[v as usize].add(mesh.positions[v as usize].as_dvec3(), n);
+            }
+        }
+        q
+    }
+
+    #[test]
+    fn reaches_the_count_and_keeps_the_genus() {
+        for (mesh, genus) in [(shapes::icosphere(1.0, 4), 0), (shapes::torus(1.0, 0.3, 64, 32), 1)] {
+            for target in [2000, 500, 100] {
+                let (out, kept) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, target);
+                let r = analyze(&out);
+                assert!(r.is_watertight(), "{r:?}");
+                assert_eq!(r.genus(), Some(genus));
+                assert!(out.triangles.len().abs_diff(target) <= 1, "{} for {target}", out.triangles.len());
+                assert_eq!(kept.len(), out.positions.len());
+            }
+        }
+    }
+
+    #[test]
+    fn a_sphere_stays_round_and_stops_at_a_tetrahedron() {
+        let mesh = shapes::icosphere(1.0, 4);
+        let (out, _) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 200);
+        for p in &out.positions {
+            assert!((p.length() - 1.0).abs() < 0.1, "{p}");
+        }
+        let (tiny, _) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 0);
+        assert_eq!(tiny.triangles.len(), 4);
+        assert!(analyze(&tiny).is_watertight());
+    }
+
+    #[test]
+    fn an_open_cap_shrinks_along_its_border_which_stays_manifold() {
+        let sphere = shapes::icosphere(1.0, 4);
+        let low = |t: &&[u32; 3]| t.iter().all(|&v| sphere.positions[v as usize].z < 0.3);
+        let triangles: Vec<[u32; 3]> = sphere.triangles.iter().filter(low).copied().collect();
+        let open = Mesh::new(sphere.positions.clone(), None, triangles);
+        let before = analyze(&open);
+        for target in [300, 60, 10] {
+            let (out, _) = decimate(&open, face_quadrics(&open), DVec3::ZERO, target);
+            let r = analyze(&out);
+            assert!(out.triangles.len().abs_diff(target) <= 1, "{} for {target}", out.triangles.len());
+            assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.components), (0, 0, 1), "{r:?}");
+            assert_eq!(r.euler_characteristic, before.euler_characteristic, "a disk stays a disk");
+            assert!(r.boundary_edges >= 3 && r.boundary_edges < before.boundary_edges);
+        }
+    }
+
+    #[test]
+    fn a_collapse_that_folds_a_face_is_refused() {
+        // A flat fan of four faces around vertex 0. Merging 0 and 2 kills faces 0-1-2 and 0-2-3
+        // and moves 0 in the other two.
+        assert_eq!(FOLD_COSINE, 0.0);
+        let positions = vec![
+            glam::Vec3::new(0.0, 0.0, 0.0),
+            glam::Vec3::new(1.0, 0.0, 0.0),
+            glam::Vec3::new(0.0, 1.0, 0.0),
+            glam::Vec3::new(-1.0, 0.0, 0.0),
+            glam::Vec3::new(0.0, -1.0, 0.0),
+        ];
+        let triangles = vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]];
+        let mesh = Mesh::new(positions, None, triangles);
+        let d = Decimator {
+            collapser: Collapser::new(&mesh),
+            positions: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
+            quadrics: face_quadrics(&mesh),
+            versions: vec![0; 5],
+            heap: BinaryHeap::new(),
+        };
+        // Inside the fan nothing turns; past vertex 4 faces 0-3-4 and 0-4-1 turn over.
+        assert!(!d.folds(2, 0, DVec3::new(0.0, 0.5, 0.0)));
+        assert!(d.folds(2, 0, DVec3::new(0.0, -2.0, 0.0)));
+        // Lifted 10 above the plane, the faces turn by 86° (cosine 1/sqrt(201)): allowed, as
+        // anything short of a right angle is; onto the line 3-4, face 0-3-4 is degenerate.
+        assert!(!d.folds(2, 0, DVec3::new(0.0, 0.0, 10.0)));
+        assert!(d.folds(2, 0, DVec3::new(-0.5, -0.5, 0.0)));
+    }
+}
