@@ -94,7 +94,8 @@ impl Collapser {
             .filter(|&t| self.alive_face[t as usize] && same_label(&self.triangles[t as usize]))
             .collect();
         if border_only {
-            candidates.retain(|&t| self.triangles[t as usize].iter().filter(|&&v| self.border[v as usize]).count() >= 2);
+            candidates
+                .retain(|&t| self.triangles[t as usize].iter().filter(|&&v| self.border[v as usize]).count() >= 2);
         }
         let mut touched = vec![false; self.alive_vertex.len()];
         loop {
