@@ -1455,13 +1455,13 @@ static const bad_case g_cases[] = {
         "vstree_reconstruct_result_take_mesh: `result` is NULL"),
     ROW(reconstruct_size_zero, INVALID_ARGUMENT,
         "vstree_reconstruct: `params->struct_size`: 0 is not a size of vstree_reconstruct_params "
-        "this library knows (80 to 80): initialise the struct with its _default() function"),
+        "this library knows (80 to 88): initialise the struct with its _default() function"),
     ROW(reconstruct_size_short, INVALID_ARGUMENT,
         "vstree_reconstruct: `params->struct_size`: 8 is not a size of vstree_reconstruct_params "
-        "this library knows (80 to 80): initialise the struct with its _default() function"),
+        "this library knows (80 to 88): initialise the struct with its _default() function"),
     ROW(reconstruct_size_long, INVALID_ARGUMENT,
         "vstree_reconstruct: `params->struct_size`: 4096 is not a size of "
-        "vstree_reconstruct_params this library knows (80 to 80): the program was compiled "
+        "vstree_reconstruct_params this library knows (80 to 88): the program was compiled "
         "against a newer vstree.h than this library"),
     ROW(reconstruct_orient_99, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `orient`: 99: must be one of 0 "
