@@ -331,9 +331,10 @@ pub struct vstree_reconstruct_result {
 
 /// Reconstructs a triangle mesh from the points of `cloud` (its triangles, if any, are
 /// ignored): normals are estimated where the cloud has none (all, or zero-length ones), the
-/// VS-Tree of the points is built, its T-nodes give a coarse closed base mesh, which is
-/// refined by the quadtrees below them until it is close enough to the points; with
-/// `params->trim` > 0, faces far from every point are removed at the end. The output has
+/// VS-Tree of the points is built, its T-nodes give a coarse base mesh (closed, or with
+/// `params->closure` VSTREE_CLOSURE_OPEN only the part the points support), which is refined
+/// by the quadtrees below them until it is close enough to the points; with `params->trim` >
+/// 0, faces far from every point are removed at the end. The output has
 /// unit per-vertex normals and counter-clockwise triangles seen from outside.
 ///
 /// `params` NULL means the defaults. `progress` (may be NULL) is called with `user_data` from
