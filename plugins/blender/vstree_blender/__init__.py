@@ -16,6 +16,7 @@ bl_info = {
     "category": "Mesh",
 }
 
+import textwrap
 import threading
 
 import bpy
@@ -422,7 +423,10 @@ class VSTREE_PT_panel(bpy.types.Panel):
         col.prop(s, "trim")
         op = col.operator(VSTREE_OT_reconstruct.bl_idname, text="Reconstruct")
         op.error, op.max_levels, op.trim = s.recon_error, s.max_levels, s.trim
-        layout.label(text=msg if ok else msg[:60])
+        # The sidebar does not wrap labels: a failure's message (which names the zip to
+        # install) is shown whole, a line per label.
+        for line in [msg] if ok else textwrap.wrap(msg, 60):
+            layout.label(text=line)
 
 
 class VSTREE_MT_menu(bpy.types.Menu):
