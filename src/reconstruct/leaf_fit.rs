@@ -69,7 +69,7 @@ impl QuadraticPatch {
 
 /// Solves the symmetric system `a x = b` by Gaussian elimination with partial pivoting; `None`
 /// when it is (nearly) singular.
-fn solve(mut a: [[f64; 6]; 6], mut b: [f64; 6]) -> Option<[f64; 6]> {
+pub(super) fn solve(mut a: [[f64; 6]; 6], mut b: [f64; 6]) -> Option<[f64; 6]> {
     let scale = (0..6).map(|i| a[i][i].abs()).fold(0.0, f64::max);
     if !(scale > 0.0 && scale.is_finite()) {
         return None;

@@ -9,7 +9,9 @@
 //!    vertex per T-node ([`base_mesh`]). Where the polygonised surface has handles, parts
 //!    thinner than the grid resolves are thickened and the thickened surface is kept if that
 //!    removes handles (see `THICKEN_CELLS`);
-//! 3. refine: split 1-to-4 on PN triangles and displace by the quadtrees ([`refine`]), until
+//! 3. refine: split 1-to-4 on PN triangles and displace by the quadtrees ([`refine`]); every
+//!    vertex of M0 and of each level is then projected onto a local quadratic fit of its nearest
+//!    samples ([`mls`]), which the quadtree's leaves alone leave off by the curvature; until
 //!    the mesh is close enough to the samples or the quadtrees have no detail left;
 //! 4. optionally trim faces far from every sample, so an open scan gives an open mesh.
 //!
@@ -21,6 +23,7 @@ mod adjacency;
 mod base_mesh;
 mod implicit;
 mod leaf_fit;
+mod mls;
 mod refine;
 mod support;
 mod winding;
@@ -78,6 +81,10 @@ const BORDER_TRIM: f32 = 2.0;
 /// T-layer: a shape that is a height field over large T-nodes (a hemisphere is one at depth 2)
 /// is otherwise polygonised on a grid too coarse to tell its own shape, or where the samples end.
 const MIN_GRID_DEPTH: u32 = 6;
+/// Farthest a vertex is moved onto the samples' local fit ([`mls`]), in units (grid cells or
+/// sample spacings) or typical T-node half sizes, whichever is larger: M0's vertices start up
+/// to a T-node's sag off the surface; a longer move would reach another part of it.
+const MLS_REACH: f32 = 2.0;
 /// Ring averages of the fine mesh's normals before its vertices are moved back.
 const NORMAL_SMOOTHING_PASSES: usize = 2;
 /// The polygonisation gives up beyond this many grid cells along the surface.
@@ -429,6 +436,10 @@ pub fn reconstruct(
     let refiner = refine::Refiner::new(&tree, &threads);
     refiner.snap_base(&mut surface);
     refiner.unfold_base(&mut surface);
+    let onto_samples = mls::SampleSurface::new(&tree.samples, &threads)?;
+    // M0's vertices are off by up to their T-node's sag, later ones by less.
+    let mls_reach = MLS_REACH * unit.max(typical_t_half);
+    mls::project_vertices(&mut surface, 0, &onto_samples, mls_reach, &threads);
     let (mut rms, mut max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
     stats.base_error = rms;
     stats.stopped = RefinementStop::MaxLevels;
@@ -443,8 +454,10 @@ pub fn reconstruct(
             break;
         }
         progress.report(0.5 + 0.45 * level as f32 / params.max_levels as f32, "refining")?;
+        let first_new = surface.positions.len();
         let (refined, level_stats) = refiner.refine(&surface, &threads);
         surface = refined;
+        mls::project_vertices(&mut surface, first_new, &onto_samples, mls_reach, &threads);
         stats.levels.push(level_stats);
         // Without a target distance only the final error is reported: no need to measure
         // each level (a hierarchy over all the triangles each time).

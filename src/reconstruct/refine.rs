@@ -451,7 +451,7 @@ fn is_folded(s: &Surface, t: &[u32; 3]) -> bool {
 }
 
 /// The corners of triangles whose normal points against the sum of their corners' normals.
-fn folded_vertices(s: &Surface) -> Vec<usize> {
+pub(crate) fn folded_vertices(s: &Surface) -> Vec<usize> {
     let mut folded: Vec<usize> =
         s.triangles.par_iter().filter(|t| is_folded(s, t)).flat_map_iter(|t| t.map(|v| v as usize)).collect();
     folded.sort_unstable();

@@ -1,0 +1,215 @@
+//! Projection of mesh vertices onto the samples' moving-least-squares surface.
+//!
+//! The quadtree displacement moves a vertex only where it is alone in an S-node with a free
+//! leaf; the others stay on PN patches of coarser vertices, off by the curvature those missed,
+//! and even a displaced one sits on one leaf's fit. Each vertex is therefore projected onto a
+//! local fit of the samples nearest to it: a plane iterated to its foot point (the weighted
+//! centroid and mean normal of its nearest samples on the same side, as in point set surfaces),
+//! then a weighted quadratic height field over that plane, which removes the plane's sag on
+//! curved parts while still averaging the samples' noise.
+
+use super::leaf_fit::solve;
+use super::refine::{folded_vertices, Surface};
+use crate::knn::KdTree;
+use crate::progress::Threads;
+use crate::tree::TreeSample;
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+/// Samples per fit: a quadratic has six coefficients, so it needs a few times more to average
+/// noise; more blur detail smaller than their spread.
+const NEIGHBOURS: usize = 24;
+/// Plane iterations towards the foot point: each one moves along the plane's normal only, and a
+/// second one corrects for the neighbourhood having changed with the first.
+const PLANE_ITERATIONS: usize = 2;
+/// A sample whose normal makes more than 90 degrees with the vertex's (cosine below this)
+/// belongs to the other side of a thin part and is left out of the fit.
+const SAME_SIDE: f32 = 0.0;
+
+/// The samples, indexed for nearest-neighbour queries.
+pub(crate) struct SampleSurface<'a> {
+    samples: &'a [TreeSample],
+    index: KdTree,
+}
+
+impl<'a> SampleSurface<'a> {
+    pub fn new(samples: &'a [TreeSample], threads: &Threads) -> crate::error::Result<SampleSurface<'a>> {
+        let positions: Vec<Vec3> = samples.iter().map(|s| s.position).collect();
+        let index = threads.run(|| KdTree::new(&positions))?;
+        Ok(SampleSurface { samples, index })
+    }
+
+    /// `p` (with normal `n`) projected onto the local fit, and the fit's normal there; `None`
+    /// where too few samples face the same way.
+    pub fn project(&self, p: Vec3, n: Vec3) -> Option<(Vec3, Vec3)> {
+        let mut q = p;
+        let mut normal = n;
+        let mut neighbours = Vec::with_capacity(NEIGHBOURS);
+        for _ in 0..PLANE_ITERATIONS {
+            self.same_side(q, n, &mut neighbours);
+            let (centroid, mean_normal) = plane(&neighbours)?;
+            normal = mean_normal;
+            q -= normal * (q - centroid).dot(normal);
+        }
+        self.same_side(q, n, &mut neighbours);
+        let (centroid, mean_normal) = plane(&neighbours)?;
+        let height = quadratic_height(&neighbours, q, centroid, mean_normal);
+        let (h, slope) = height.unwrap_or(((q - centroid).dot(mean_normal), DVec3::ZERO));
+        let foot = q - mean_normal * ((q - centroid).dot(mean_normal) - h);
+        let fit_normal = (mean_normal.as_dvec3() - slope).normalize_or_zero().as_vec3();
+        Some((foot, if fit_normal == Vec3::ZERO { normal } else { fit_normal }))
+    }
+
+    /// The nearest samples to `q` whose normals agree with `n`, with weights that fall to zero
+    /// at the farthest one (Wendland's (1 - r²)²).
+    fn same_side(&self, q: Vec3, n: Vec3, out: &mut Vec<(Vec3, Vec3, f64)>) {
+        out.clear();
+        let found = self.index.knn(q, NEIGHBOURS);
+        let reach2 = found.last().map_or(0.0, |f| f.distance_squared) * 1.1 + f32::MIN_POSITIVE;
+        for f in found {
+            let s = &self.samples[f.index as usize];
+            if s.normal.dot(n) > SAME_SIDE {
+                let r2 = f64::from(f.distance_squared / reach2);
+                out.push((s.position, s.normal, (1.0 - r2).powi(2)));
+            }
+        }
+    }
+}
+
+/// Weighted centroid and mean unit normal of `points`; `None` when fewer than three, or the
+/// normals cancel out.
+fn plane(points: &[(Vec3, Vec3, f64)]) -> Option<(Vec3, Vec3)> {
+    if points.len() < 3 {
+        return None;
+    }
+    let (mut c, mut n, mut w) = (DVec3::ZERO, DVec3::ZERO, 0.0);
+    for &(p, m, weight) in points {
+        c += p.as_dvec3() * weight;
+        n += m.as_dvec3() * weight;
+        w += weight;
+    }
+    let n = n.normalize_or_zero();
+    (w > 0.0 && n != DVec3::ZERO).then(|| ((c / w).as_vec3(), n.as_vec3()))
+}
+
+/// The weighted least-squares quadratic height field h(x, y) over the plane through `centroid`
+/// with normal `normal`, evaluated at `q`'s plane coordinates: the height, and the gradient as
+/// a vector in the plane (for the fit's normal, `normal - gradient`). `None` when the samples
+/// do not determine one.
+fn quadratic_height(points: &[(Vec3, Vec3, f64)], q: Vec3, centroid: Vec3, normal: Vec3) -> Option<(f32, DVec3)> {
+    let n = normal.as_dvec3();
+    let u = n.any_orthonormal_vector();
+    let v = n.cross(u);
+    let o = centroid.as_dvec3();
+    // Coordinates in units of the neighbourhood's spread keep the system well conditioned.
+    let scale = points.iter().map(|(p, _, _)| (p.as_dvec3() - o).length()).fold(0.0, f64::max);
+    if scale <= 0.0 {
+        return None;
+    }
+    let mut a = [[0.0f64; 6]; 6];
+    let mut b = [0.0f64; 6];
+    for &(p, _, w) in points {
+        let d = (p.as_dvec3() - o) / scale;
+        let phi = basis(d.dot(u), d.dot(v));
+        let h = d.dot(n);
+        for i in 0..6 {
+            b[i] += w * phi[i] * h;
+            for j in 0..6 {
+                a[i][j] += w * phi[i] * phi[j];
+            }
+        }
+    }
+    let c = solve(a, b)?;
+    let d = (q.as_dvec3() - o) / scale;
+    let (x, y) = (d.dot(u), d.dot(v));
+    let height = basis(x, y).iter().zip(&c).map(|(f, k)| f * k).sum::<f64>() * scale;
+    let (dx, dy) = (c[1] + 2.0 * c[3] * x + c[4] * y, c[2] + c[4] * x + 2.0 * c[5] * y);
+    Some((height as f32, u * dx + v * dy))
+}
+
+fn basis(x: f64, y: f64) -> [f64; 6] {
+    [1.0, x, y, x * x, x * y, y * y]
+}
+
+/// Projects the vertices of `s` from `first` on onto the samples' surface, each at most `reach`
+/// (a move farther than that would land on another part of the surface), and undoes the moves
+/// that fold a triangle over.
+pub(crate) fn project_vertices(s: &mut Surface, first: usize, onto: &SampleSurface, reach: f32, threads: &Threads) {
+    let moves: Vec<(usize, Vec3, Vec3)> = threads.run(|| {
+        (first..s.positions.len())
+            .into_par_iter()
+            .filter_map(|v| {
+                let (p, n) = onto.project(s.positions[v], s.normals[v])?;
+                (p.distance(s.positions[v]) <= reach).then_some((v, p, n))
+            })
+            .collect()
+    });
+    let mut before = Vec::with_capacity(moves.len());
+    for &(v, p, n) in &moves {
+        before.push((v, s.positions[v], s.normals[v]));
+        s.positions[v] = p;
+        s.normals[v] = n;
+    }
+    let folded = folded_vertices(s);
+    for (v, p, n) in before {
+        if folded.binary_search(&v).is_ok() {
+            s.positions[v] = p;
+            s.normals[v] = n;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sphere_samples(n: usize, radius: f32) -> Vec<TreeSample> {
+        // A Fibonacci sphere: even spacing, exact outward normals.
+        (0..n)
+            .map(|i| {
+                let z = 1.0 - (2.0 * i as f32 + 1.0) / n as f32;
+                let r = (1.0 - z * z).sqrt();
+                let phi = i as f32 * std::f32::consts::PI * (3.0 - 5f32.sqrt());
+                let normal = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+                TreeSample { position: normal * radius, normal, index: i as u32 }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_point_off_a_sphere_lands_on_it_without_the_planes_sag() {
+        let samples = sphere_samples(4000, 1.0);
+        let surface = SampleSurface::new(&samples, &Threads::new(1).unwrap()).unwrap();
+        for dir in [Vec3::new(0.3, -0.5, 0.8), Vec3::X, Vec3::new(-0.2, 0.1, -0.9)] {
+            let dir = dir.normalize();
+            for r in [0.97, 1.0, 1.03] {
+                let (p, n) = surface.project(dir * r, dir).expect("a fit");
+                // The plane through 24 samples' centroid sits inside by their sag (about 1e-3
+                // here); the quadratic is within 1e-4.
+                assert!((p.length() - 1.0).abs() < 1e-4, "{r}: {}", p.length());
+                assert!(p.normalize().dot(dir) > 0.9999, "moved sideways: {p}");
+                assert!(n.dot(p.normalize()) > 0.999, "normal {n}");
+            }
+        }
+    }
+
+    #[test]
+    fn samples_of_the_other_side_of_a_thin_plate_are_left_out() {
+        // Two sheets 0.01 apart (z = 0 facing down, z = 0.01 facing up), samples every 0.02:
+        // the nearest samples mix both; a vertex on the upper one stays on it.
+        let mut samples = Vec::new();
+        for i in 0..41 {
+            for j in 0..41 {
+                let (x, y) = (i as f32 * 0.02 - 0.4, j as f32 * 0.02 - 0.4);
+                let index = samples.len() as u32;
+                samples.push(TreeSample { position: Vec3::new(x, y, 0.0), normal: -Vec3::Z, index });
+                samples.push(TreeSample { position: Vec3::new(x, y, 0.01), normal: Vec3::Z, index: index + 1 });
+            }
+        }
+        let surface = SampleSurface::new(&samples, &Threads::new(1).unwrap()).unwrap();
+        let (p, _) = surface.project(Vec3::new(0.013, 0.0, 0.008), Vec3::Z).unwrap();
+        assert!((p.z - 0.01).abs() < 1e-5, "{p}");
+        let (p, _) = surface.project(Vec3::new(0.013, 0.0, 0.002), -Vec3::Z).unwrap();
+        assert!(p.z.abs() < 1e-5, "{p}");
+    }
+}
