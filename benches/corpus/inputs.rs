@@ -112,6 +112,17 @@ impl Variant {
             Variant::Text => "f64 text",
         }
     }
+
+    /// The name in output files and on the command line (`--variants`).
+    pub fn file_name(self) -> &'static str {
+        match self {
+            Variant::Clean => "clean",
+            Variant::NoNormals => "nonormals",
+            Variant::Noisy => "noisy",
+            Variant::Open => "open",
+            Variant::Text => "text",
+        }
+    }
 }
 
 /// A mesh model and where it comes from.

@@ -41,6 +41,7 @@ usage: cargo bench --bench corpus -- [options]
   --sizes A,B           points sampled on each mesh (default 200000,1000000)
   --models A,B          only these meshes (stems; default: the 16 of the corpus and the closed
                         ones of the data directory; or none); single views only of those among them
+  --variants A,B        only these samplings of the meshes: clean, nonormals, noisy (default: all)
   --quick               20k points, 3 models (bull, femur, triceratops), small synthetic cases
   --reduced             sizes above the smallest only for the corpus's clean variant
   --no-synthetic        skip the hemisphere, single views and spheres
@@ -66,6 +67,7 @@ pub struct Options {
     peers: bool,
     sizes: Vec<usize>,
     models: Option<Vec<String>>,
+    variants: Option<Vec<String>>,
     quick: bool,
     reduced: bool,
     synthetic: bool,
@@ -85,6 +87,7 @@ impl Options {
             peers: false,
             sizes: vec![200_000, 1_000_000],
             models: None,
+            variants: None,
             quick: false,
             reduced: false,
             synthetic: true,
@@ -115,6 +118,7 @@ impl Options {
                     let v = value()?;
                     o.models = Some(if v == "none" { Vec::new() } else { names(v) });
                 }
+                "--variants" => o.variants = Some(names(value()?)),
                 "--methods" => o.methods = names(value()?),
                 "--big-methods" => o.big_methods = Some(names(value()?)),
                 "--runs" => o.runs = number(value()?)?,
@@ -146,6 +150,9 @@ impl Options {
         {
             return Err(format!("unknown peer {bad}: the peers are {}", known.join(", ")));
         }
+        if let Some(bad) = o.variants.iter().flatten().find(|v| !Variant::SAMPLED.iter().any(|k| k.file_name() == *v)) {
+            return Err(format!("unknown variant {bad}: the variants are clean, nonormals, noisy"));
+        }
         let models = inputs::models(&o.data);
         if let Some(bad) = o.models.iter().flatten().find(|m| !models.iter().any(|k| k.name == **m)) {
             let known: Vec<&str> = models.iter().map(|k| k.name.as_str()).collect();
@@ -164,7 +171,8 @@ impl Options {
         let mut out = Vec::new();
         for &size in &self.sizes {
             for variant in Variant::SAMPLED {
-                if !self.reduced || size == smallest || (corpus && variant == Variant::Clean) {
+                let named = self.variants.as_ref().is_none_or(|v| v.iter().any(|n| n == variant.file_name()));
+                if named && (!self.reduced || size == smallest || (corpus && variant == Variant::Clean)) {
                     out.push((size, variant));
                 }
             }
@@ -228,13 +236,7 @@ struct Case<'a> {
 impl Case<'_> {
     /// A file name: `bear-200k-clean`.
     fn stem(&self) -> String {
-        let variant = match self.variant {
-            Variant::Clean => "clean",
-            Variant::NoNormals => "nonormals",
-            Variant::Noisy => "noisy",
-            Variant::Open => "open",
-            Variant::Text => "text",
-        };
+        let variant = self.variant.file_name();
         let name: String =
             self.name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '-' }).collect();
         format!("{name}-{}-{variant}", short_count(self.cloud.positions.len())).replace("--", "-")
