@@ -110,6 +110,17 @@
 #define VSTREE_ORIENTATION_PROPAGATE_OUTWARD 3
 
 /**
+ * `base_mesh` value: the points' winding number says inside or outside, the distance to the
+ * nearest point how far (the default).
+ */
+#define VSTREE_BASE_MESH_WINDING 0
+
+/**
+ * `base_mesh` value: the paper's blend of the T-nodes' planes near the points.
+ */
+#define VSTREE_BASE_MESH_PAPER 1
+
+/**
  * `closure` value: open when more than 15% of the closed surface is far from every point.
  * Experimental: some noisy or sparse closed clouds come out open.
  */
@@ -981,10 +992,11 @@ typedef struct vstree_reconstruct_params {
    */
   int32_t closure;
   /**
-   * Must be 0 (keeps the struct free of padding; a later version may give it a meaning).
-   * Since 0.2.0.
+   * What decides the base mesh's inside and outside, a VSTREE_BASE_MESH_* value. Default
+   * VSTREE_BASE_MESH_WINDING; VSTREE_BASE_MESH_PAPER is the paper's construction, to compare
+   * with. Since 0.2.0.
    */
-  uint32_t reserved;
+  int32_t base_mesh;
 } vstree_reconstruct_params;
 
 /**

@@ -5,7 +5,7 @@ mod common;
 
 use glam::Vec3;
 use vstree::distance::chamfer_and_hausdorff;
-use vstree::reconstruct::{reconstruct, Closure, ReconstructParams, ReconstructStats, RefinementStop};
+use vstree::reconstruct::{reconstruct, BaseMesh, Closure, ReconstructParams, ReconstructStats, RefinementStop};
 use vstree::tree::TreeParams;
 use vstree::{shapes, topology, Error, Mesh, Progress};
 
@@ -79,6 +79,23 @@ fn generated_torus_and_double_torus_keep_their_genus() {
     assert_closed_reconstruction("torus", &torus, 1);
     let double = shapes::sample_surface(&shapes::double_torus(), 80_000, 2);
     assert_closed_reconstruction("double torus", &double, 2);
+}
+
+#[test]
+fn the_winding_base_mesh_keeps_a_thin_ring_that_the_planes_flatten() {
+    // A ring 0.06 thick on a 2-wide torus: its T-nodes are several times larger than its
+    // section, so their blended planes flatten it, where the winding number and the distance
+    // to the samples follow it. Measured Chamfer 1.50e-4 (winding) and 2.19e-4 (paper).
+    let truth = shapes::torus(1.0, 0.03, 256, 32);
+    let cloud = shapes::sample_surface(&truth, 60_000, 1);
+    let mut chamfers = Vec::new();
+    for base_mesh in [BaseMesh::Winding, BaseMesh::Paper] {
+        let (mesh, stats) = run(&cloud, &ReconstructParams { base_mesh, ..Default::default() });
+        assert_eq!(stats.base_genus, Some(1), "{base_mesh:?}: M0's genus");
+        assert_eq!(topology::analyze(&mesh).genus(), Some(1), "{base_mesh:?}: the result's genus");
+        chamfers.push(chamfer_and_hausdorff(&mesh, &truth, 100_000, 1).0);
+    }
+    assert!(chamfers[0] < 0.8 * chamfers[1], "Chamfer: winding {:.3e}, paper {:.3e}", chamfers[0], chamfers[1]);
 }
 
 #[test]
@@ -233,13 +250,13 @@ fn a_hemisphere_gives_an_open_dome_up_to_its_rim() {
         let border_heights: Vec<f32> = border_vertices(&mesh).iter().map(|&v| mesh.positions[v].z).collect();
         let highest = border_heights.iter().copied().fold(f32::MIN, f32::max);
         let lowest = border_heights.iter().copied().fold(f32::MAX, f32::min);
-        // Measured: from -3.4 to +2.5 spacings at 10k points (the border overshoots by up to a
+        // Measured: from -1.7 to +3.2 spacings at 10k points (the border overshoots by up to a
         // grid cell, and is trimmed back as much where the refined surface strays).
         // Below the rim the overshoot is up to about a grid cell (the grid spans the cloud's
         // width of 2 in `grid_cells` cells; at 100k points it is 8 spacings).
         let cell = 2.0 / stats.grid_cells as f32;
         assert!(
-            highest < 3.0 * h && lowest > -(2.0 * cell).max(4.0 * h),
+            highest < 3.5 * h && lowest > -(2.0 * cell).max(4.0 * h),
             "{count}: border from z = {lowest} to {highest}, spacing {h}, cell {cell}"
         );
     }

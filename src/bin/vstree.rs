@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use vstree::reconstruct::{reconstruct, Closure, ReconstructParams, ReconstructStats, RefinementStop};
+use vstree::reconstruct::{reconstruct, BaseMesh, Closure, ReconstructParams, ReconstructStats, RefinementStop};
 use vstree::simplify::{simplify, KeepTopology, SimplifyParams, SimplifyStats};
 use vstree::tree::{Metric, TreeKind, TreeParams, TreeStats};
 use vstree::{io, MeshSampling, Progress, SampleSet, Threads};
@@ -101,6 +101,9 @@ enum Command {
         /// sample (experimental: some noisy or sparse closed clouds come out open).
         #[arg(long)]
         detect_open: bool,
+        /// What decides the base mesh's inside and outside.
+        #[arg(long, value_enum, default_value_t = BaseMeshArg::Winding)]
+        base_mesh: BaseMeshArg,
         /// Re-orient the normals the cloud already has (consistent by spanning-tree
         /// propagation, then facing outward). Clouds without normals always get them estimated.
         #[arg(long)]
@@ -202,6 +205,15 @@ enum MetricArg {
     L21,
     /// Sample count: at most `--error` samples per cluster (cheap, for huge inputs).
     Density,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum BaseMeshArg {
+    /// The points' winding number says inside or outside, the distance to the nearest point how
+    /// far: robust topology on thin parts and narrow gaps, details down to the point spacing.
+    Winding,
+    /// The paper's construction: the T-nodes' planes blended near the points (to compare with).
+    Paper,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -362,6 +374,7 @@ fn run(command: Command) -> vstree::Result<()> {
             trim,
             open,
             detect_open,
+            base_mesh,
             reorient,
             neighbours,
             ascii,
@@ -377,6 +390,10 @@ fn run(command: Command) -> vstree::Result<()> {
                     (true, _) => Closure::Open,
                     (_, true) => Closure::Auto,
                     _ => Closure::Closed,
+                },
+                base_mesh: match base_mesh {
+                    BaseMeshArg::Winding => BaseMesh::Winding,
+                    BaseMeshArg::Paper => BaseMesh::Paper,
                 },
                 threads: tree.threads,
                 ..ReconstructParams::default()

@@ -5,9 +5,9 @@ use super::mesh::{into_handle, mesh_ref, vstree_mesh};
 use super::normals::{flag, orientation, orientation_value, threads};
 use super::params::{self, one_of, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
-use super::{guard, guard_or, non_null, vstree_status, write_out, Failure, FfiResult};
+use super::{guard, guard_or, non_null, vstree_status, write_out, FfiResult};
 use crate::normals::NormalParams;
-use crate::reconstruct::{reconstruct, Closure, ReconstructParams, ReconstructStats, RefinementStop};
+use crate::reconstruct::{reconstruct, BaseMesh, Closure, ReconstructParams, ReconstructStats, RefinementStop};
 use crate::tree::{Metric, TreeKind, TreeParams};
 use std::ffi::c_void;
 use std::mem::size_of;
@@ -74,10 +74,17 @@ pub struct vstree_reconstruct_params {
     /// VSTREE_CLOSURE_OPEN for a scan from one side (only the part of the surface the points
     /// support is kept). Since 0.2.0.
     pub closure: i32,
-    /// Must be 0 (keeps the struct free of padding; a later version may give it a meaning).
-    /// Since 0.2.0.
-    pub reserved: u32,
+    /// What decides the base mesh's inside and outside, a VSTREE_BASE_MESH_* value. Default
+    /// VSTREE_BASE_MESH_WINDING; VSTREE_BASE_MESH_PAPER is the paper's construction, to compare
+    /// with. Since 0.2.0.
+    pub base_mesh: i32,
 }
+
+/// `base_mesh` value: the points' winding number says inside or outside, the distance to the
+/// nearest point how far (the default).
+pub const VSTREE_BASE_MESH_WINDING: i32 = 0;
+/// `base_mesh` value: the paper's blend of the T-nodes' planes near the points.
+pub const VSTREE_BASE_MESH_PAPER: i32 = 1;
 
 /// `closure` value: open when more than 15% of the closed surface is far from every point.
 /// Experimental: some noisy or sparse closed clouds come out open.
@@ -106,6 +113,22 @@ fn closure(value: i32) -> FfiResult<Closure> {
 }
 
 /// The C value of a closure.
+fn base_mesh(value: i32) -> FfiResult<BaseMesh> {
+    let value = one_of(
+        "base_mesh",
+        value,
+        &[(VSTREE_BASE_MESH_WINDING, "VSTREE_BASE_MESH_WINDING"), (VSTREE_BASE_MESH_PAPER, "VSTREE_BASE_MESH_PAPER")],
+    )?;
+    Ok(if value == VSTREE_BASE_MESH_PAPER { BaseMesh::Paper } else { BaseMesh::Winding })
+}
+
+fn base_mesh_value(base_mesh: BaseMesh) -> i32 {
+    match base_mesh {
+        BaseMesh::Winding => VSTREE_BASE_MESH_WINDING,
+        BaseMesh::Paper => VSTREE_BASE_MESH_PAPER,
+    }
+}
+
 fn closure_value(closure: Closure) -> i32 {
     match closure {
         Closure::Auto => VSTREE_CLOSURE_AUTO,
@@ -137,7 +160,7 @@ unsafe impl Versioned for vstree_reconstruct_params {
             reorient_given: u32::from(d.normals.reorient_given),
             threads: 0,
             closure: closure_value(d.closure),
-            reserved: 0,
+            base_mesh: base_mesh_value(d.base_mesh),
         }
     }
 }
@@ -162,9 +185,6 @@ pub(crate) unsafe fn read_reconstruct_params(
         threads,
     };
     normals.check()?;
-    if p.reserved != 0 {
-        return Err(Failure::parameter("reserved", format!("{}: must be 0", p.reserved)));
-    }
     let params = ReconstructParams {
         tree: TreeParams {
             kind: TreeKind::VsTree,
@@ -182,6 +202,7 @@ pub(crate) unsafe fn read_reconstruct_params(
         max_grid_depth: p.max_grid_depth,
         trim: p.trim,
         closure: closure(p.closure)?,
+        base_mesh: base_mesh(p.base_mesh)?,
         normals,
         threads,
     };
@@ -476,7 +497,7 @@ mod tests {
             ("reorient_given", |p| p.reorient_given = 7),
             ("threads", |p| p.threads = u32::MAX),
             ("closure", |p| p.closure = 3),
-            ("reserved", |p| p.reserved = 1),
+            ("base_mesh", |p| p.base_mesh = 2),
         ];
         for (field, spoil) in cases {
             let mut p = vstree_reconstruct_params_default();

@@ -99,6 +99,25 @@ pub(crate) struct BaseMesh {
     pub labels: Vec<u32>,
 }
 
+impl BaseMesh {
+    /// Removes the vertices no triangle uses, with their labels.
+    pub fn drop_unused_vertices(&mut self) {
+        let mut index = vec![u32::MAX; self.mesh.positions.len()];
+        let (mut positions, mut labels) = (Vec::new(), Vec::new());
+        for t in self.mesh.triangles.iter_mut() {
+            for v in t.iter_mut() {
+                if index[*v as usize] == u32::MAX {
+                    index[*v as usize] = positions.len() as u32;
+                    positions.push(self.mesh.positions[*v as usize]);
+                    labels.push(self.labels[*v as usize]);
+                }
+                *v = index[*v as usize];
+            }
+        }
+        (self.mesh.positions, self.labels) = (positions, labels);
+    }
+}
+
 /// Collapses every edge whose ends share a label, while the link condition allows, and places
 /// each remaining vertex at the mean of the fine vertices it absorbed. Stray components
 /// (bubbles of the implicit function, see [`stray_components`]) are dropped.

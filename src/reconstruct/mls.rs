@@ -19,6 +19,9 @@ use rayon::prelude::*;
 /// Samples per fit: a quadratic has six coefficients, so it needs a few times more to average
 /// noise; more blur detail smaller than their spread.
 const NEIGHBOURS: usize = 24;
+/// Samples whose tangent planes vote for the side of a point next to them: a few, so that one
+/// noisy normal does not decide, and few enough to stay on one side of a thin part.
+const SIDE_NEIGHBOURS: usize = 8;
 /// Plane iterations towards the foot point: each one moves along the plane's normal only, and a
 /// second one corrects for the neighbourhood having changed with the first.
 const PLANE_ITERATIONS: usize = 2;
@@ -37,6 +40,20 @@ impl<'a> SampleSurface<'a> {
         let positions: Vec<Vec3> = samples.iter().map(|s| s.position).collect();
         let index = threads.run(|| KdTree::new(&positions))?;
         Ok(SampleSurface { samples, index })
+    }
+
+    /// The mean signed distance from `p` to the tangent planes of its [`SIDE_NEIGHBOURS`]
+    /// nearest samples: positive on their normals' side.
+    pub fn plane_side(&self, p: Vec3) -> f32 {
+        let found = self.index.knn(p, SIDE_NEIGHBOURS);
+        let sum: f32 = found
+            .iter()
+            .map(|f| {
+                let s = &self.samples[f.index as usize];
+                s.normal.dot(p - s.position)
+            })
+            .sum();
+        sum / found.len().max(1) as f32
     }
 
     /// `p` (with normal `n`) projected onto the local fit, and the fit's normal there; `None`

@@ -2,9 +2,10 @@
 //!
 //! 0. estimate normals where the cloud has none ([`crate::normals`]);
 //! 1. build the VS-Tree of the samples (the L2 bound is the de-noising control);
-//! 2. blend the T-nodes' planes into one implicit function ([`implicit`]); farther than a grid
-//!    cell or two from every sample, the samples' winding number ([`winding`]) decides inside
-//!    or outside instead; polygonise that on a grid as fine as the deepest T-node
+//! 2. an implicit function whose sign is inside or outside: by default the samples' winding
+//!    number ([`winding`]) decides the side and the distance to the nearest sample the value
+//!    ([`BaseMesh::Winding`]); the paper's blend of the T-nodes' planes ([`implicit`]) is
+//!    [`BaseMesh::Paper`]. Polygonise it on a grid as fine as the deepest T-node
 //!    ([`crate::polygonize`]), and cluster that mesh at the T-layer into the base mesh M0, one
 //!    vertex per T-node ([`base_mesh`]). Where the polygonised surface has handles, parts
 //!    thinner than the grid resolves are thickened and the thickened surface is kept if that
@@ -81,6 +82,14 @@ const BORDER_TRIM: f32 = 2.0;
 /// T-layer: a shape that is a height field over large T-nodes (a hemisphere is one at depth 2)
 /// is otherwise polygonised on a grid too coarse to tell its own shape, or where the samples end.
 const MIN_GRID_DEPTH: u32 = 6;
+/// The winding number's dipoles are softened over this many sample spacings (see
+/// [`winding::WindingNumber::softened`]): within a spacing of the samples the cloud cannot
+/// tell the surface from its samples, and an unsoftened sum there swings with the nearest one.
+const WINDING_SOFTENING: f32 = 1.0;
+/// Where the output may be open, a winding number within this of one half next to the samples
+/// is in doubt, and the nearest samples' tangent planes decide the side instead: about 1
+/// inside and 0 outside a closed surface, it sinks towards 0 near the border of an open scan.
+const WINDING_DOUBT: f32 = 0.25;
 /// Farthest a vertex is moved onto the samples' local fit ([`mls`]), in units (grid cells or
 /// sample spacings) or typical T-node half sizes, whichever is larger: M0's vertices start up
 /// to a T-node's sag off the surface; a longer move would reach another part of it.
@@ -91,6 +100,20 @@ const NORMAL_SMOOTHING_PASSES: usize = 2;
 const MAX_GRID_CELLS: usize = 50_000_000;
 /// Fewer points than this cannot define a surface.
 pub const MIN_POINTS: usize = 10;
+
+/// What decides inside and outside for the base mesh.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BaseMesh {
+    /// The samples' winding number gives the side everywhere, the distance to the nearest
+    /// sample the value. The winding number is a property of the whole cloud, so the topology
+    /// does not depend on how large the T-nodes near a thin part or a narrow gap are, and the
+    /// distance keeps details down to the sample spacing. The default.
+    #[default]
+    Winding,
+    /// The paper's §5.2: the T-nodes' planes blended by a partition of unity near the samples
+    /// (the winding number only decides beyond them). Kept to compare with.
+    Paper,
+}
 
 /// Parameters of [`reconstruct`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -119,6 +142,8 @@ pub struct ReconstructParams {
     /// samples support (an open scan, or a scan's holes kept open); `Auto` decides from how
     /// much of the closed surface is far from every sample.
     pub closure: Closure,
+    /// How the base mesh's inside and outside are decided.
+    pub base_mesh: BaseMesh,
     /// Normals: estimated where the cloud has none (PCA over neighbours, oriented by spanning
     /// tree propagation, turned outward); the cloud's own are kept unless
     /// `normals.reorient_given`.
@@ -138,6 +163,7 @@ impl Default for ReconstructParams {
             max_grid_depth: 10,
             trim: 0.0,
             closure: Closure::Closed,
+            base_mesh: BaseMesh::Winding,
             normals: NormalParams::default(),
             threads: 0,
         }
@@ -324,38 +350,41 @@ pub fn reconstruct(
     let grid = polygonisation_grid(&tree, params.max_grid_depth, spacing);
     stats.grid_cells = grid.dims[0] - 5;
     drop(tree_order);
-    let blend = implicit::PlaneBlend::new(&tree, SUPPORT_SCALE, 1.5 * grid.cell);
     // Distances from the samples count in grid cells, or in sample spacings where the samples
     // are sparser than the grid.
     let unit = grid.cell.max(spacing);
     // A T-node's plane strays from its samples by up to its patch's sag, so the cap on the
     // distance to the samples must leave room for the typical T-node too.
     let typical_t_half = median(tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| n.half).collect());
-    let tolerance = FAR_FROM_SAMPLES * unit;
-    let winding = winding::WindingNumber::new(&tree);
     let inside_above = if params.trim > 0.0 || params.closure == Closure::Open { OPEN_SCAN_INSIDE } else { 0.5 };
     let far = OUTSIDE_BEYOND * unit.max(typical_t_half);
-    let f = |p: Vec3| {
-        if near.any_within(p, tolerance) {
-            return blend.eval(p);
-        }
-        // Far from the samples the planes are extrapolations: the winding number says which
-        // side p is on, and the function moves away from zero on that side.
-        let side = if winding.at(p) > inside_above { -1.0 } else { 1.0 };
-        let d = near.distance_within(p, far);
-        let blended = if d <= far { blend.eval(p) } else { f32::MAX };
-        if blended == f32::MAX {
-            side * f32::MAX
-        } else {
-            // The winding number's side wins; the planes may only push further that way.
-            // Otherwise planes that run on past a thin part bulge into the outside, and a
-            // bulge that meets another part adds a handle.
-            if side > 0.0 {
-                blended.max(0.0) + (d - tolerance)
+    let softening = if params.base_mesh == BaseMesh::Winding { WINDING_SOFTENING * spacing } else { 0.0 };
+    let winding = winding::WindingNumber::new(&tree).softened(softening);
+    let onto_samples = mls::SampleSurface::new(&tree.samples, &threads)?;
+    let blend = implicit::PlaneBlend::new(&tree, SUPPORT_SCALE, 1.5 * grid.cell);
+    let tolerance = FAR_FROM_SAMPLES * unit;
+    let may_open = params.closure != Closure::Closed || params.trim > 0.0;
+    let f = |p: Vec3| match params.base_mesh {
+        BaseMesh::Winding => {
+            let d = near.distance_within(p, far).min(far);
+            let w = winding.at(p);
+            let inside = if may_open && d <= tolerance && (w - 0.5).abs() < WINDING_DOUBT {
+                // Next to the samples where the winding number is in doubt (an open scan's
+                // falls towards its border, so its level set leaves the samples there), their
+                // own tangent planes tell the side. Not for a closed output: there the level
+                // set may leave an open scan's border, since the scan is closed over anyway,
+                // and the planes of noisy or thin parts would add handles.
+                onto_samples.plane_side(p) < 0.0
             } else {
-                blended.min(0.0) - (d - tolerance)
+                w > inside_above
+            };
+            if inside {
+                -d
+            } else {
+                d
             }
         }
+        BaseMesh::Paper => paper_function(p, &near, &blend, &winding, inside_above, tolerance, far),
     };
     // Polygonised `offset` outside the zero set, from the cells the surface should cross.
     let polygonise = |offset: f32| {
@@ -407,14 +436,18 @@ pub fn reconstruct(
         let mut u = unsupported.iter();
         fine.triangles.retain(|_| !*u.next().unwrap_or(&false));
         // Parts left smaller than the smallest hole are shreds of the closing sheet's edge.
-        let (part, parts) = support::regions(&fine, &vec![true; fine.triangles.len()]);
-        let mut p = part.iter();
-        fine.triangles.retain(|_| p.next().is_some_and(|&r| parts[r as usize].area >= smallest_hole));
+        drop_small_parts(&mut fine, smallest_hole);
         adjacency::Rows::neighbours(&fine.triangles, fine.positions.len())
     } else {
         neighbours
     };
-    let base = base_mesh::cluster_at_t_layer(&fine, &labels, &neighbours, grid.cell);
+    let mut base = base_mesh::cluster_at_t_layer(&fine, &labels, &neighbours, grid.cell);
+    // Closed parts of M0 smaller than the smallest hole are shells that clustering flattened
+    // (a few T-nodes on a bubble of the implicit function): nothing a T-node can stand for.
+    // (An open M0's parts were sorted out on the fine mesh, where a part is not cut short.)
+    if !stats.open && drop_small_parts(&mut base.mesh, smallest_hole) {
+        base.drop_unused_vertices();
+    }
     drop((fine, labels, neighbours));
     if base.mesh.triangles.is_empty() {
         return Err(Error::input(
@@ -436,7 +469,6 @@ pub fn reconstruct(
     let refiner = refine::Refiner::new(&tree, &threads);
     refiner.snap_base(&mut surface);
     refiner.unfold_base(&mut surface);
-    let onto_samples = mls::SampleSurface::new(&tree.samples, &threads)?;
     // M0's vertices are off by up to their T-node's sag, later ones by less.
     let mls_reach = MLS_REACH * unit.max(typical_t_half);
     mls::project_vertices(&mut surface, 0, &onto_samples, mls_reach, &threads);
@@ -503,6 +535,46 @@ pub fn reconstruct(
     stats.seconds_base = (t2 - t1).as_secs_f64();
     stats.seconds_refine = (t3 - t2).as_secs_f64();
     Ok((mesh, stats))
+}
+
+/// Removes the connected parts of `mesh` whose area is below `smallest`; whether any went.
+fn drop_small_parts(mesh: &mut Mesh, smallest: f64) -> bool {
+    let (part, parts) = support::regions(mesh, &vec![true; mesh.triangles.len()]);
+    if parts.iter().all(|p| p.area >= smallest) {
+        return false;
+    }
+    let mut p = part.iter();
+    mesh.triangles.retain(|_| p.next().is_some_and(|&r| parts[r as usize].area >= smallest));
+    true
+}
+
+/// The paper's implicit function ([`BaseMesh::Paper`]): within `tolerance` of the samples the
+/// blended T-node planes; farther out the winding number's side, pushed away from zero with the
+/// distance, the planes only allowed to push further that way; beyond `far` the side alone.
+fn paper_function(
+    p: Vec3,
+    near: &PointBvh,
+    blend: &implicit::PlaneBlend,
+    winding: &winding::WindingNumber,
+    inside_above: f32,
+    tolerance: f32,
+    far: f32,
+) -> f32 {
+    if near.any_within(p, tolerance) {
+        return blend.eval(p);
+    }
+    let side = if winding.at(p) > inside_above { -1.0 } else { 1.0 };
+    let d = near.distance_within(p, far);
+    let blended = if d <= far { blend.eval(p) } else { f32::MAX };
+    if blended == f32::MAX {
+        side * f32::MAX
+    } else if side > 0.0 {
+        // Otherwise planes that run on past a thin part bulge into the outside, and a bulge
+        // that meets another part adds a handle.
+        blended.max(0.0) + (d - tolerance)
+    } else {
+        blended.min(0.0) - (d - tolerance)
+    }
 }
 
 /// The grid the base mesh is polygonised on: cells the size of the deepest T-node's cube, but

@@ -800,7 +800,10 @@ static void reconstruction(const vstree_mesh *cloud, const vstree_mesh *cloud_no
     CHECK(s->final_error > 0 && s->final_error <= s->final_max_error && s->final_error < 1e-2);
     CHECK(s->trimmed_triangles == 0);
     CHECK(s->seconds_total >= s->seconds_tree && s->seconds_tree >= 0 && s->seconds_refine >= 0);
-    CHECK(s->thickened == 0); /* a torus polygonises with its one handle: nothing to thicken */
+    /* On this coarse grid (64 cells) the winding number's plain polygonisation of the
+       estimated-normal torus has extra handles that thickening removes; either way M0 has the
+       torus's one handle (checked above). */
+    CHECK(s->thickened == 0 || s->thickened == 1);
     CHECK(s->stopped <= VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET);
     CHECK(s->stopped != VSTREE_REFINEMENT_STOPPED_MAX_LEVELS || s->levels == p.max_levels);
     EXPECT(VSTREE_STATUS_OK, NULL, vstree_mesh_copy_triangles(out, tri, 3 * t));

@@ -344,9 +344,11 @@ PARAMETER_CASES = [
     case("reconstruct-simplify-only-parameter", reconstruct_with(metric="l2"), TypeError, None,
          "vstree.reconstruct: unknown parameter 'metric' (the parameters are error, orient, d_a, d_d, "
          "max_depth, max_levels, min_cell_size, target_distance, min_displaced, max_triangles, "
-         "max_grid_depth, trim, neighbours, reorient_given, threads, closure)"),
+         "max_grid_depth, trim, neighbours, reorient_given, threads, closure, base_mesh)"),
     case("reconstruct-closure-unknown", reconstruct_with(closure="half"), ValueError, None,
          "vstree.reconstruct: parameter `closure`: 'half' is not one of 'auto', 'closed', 'open'"),
+    case("reconstruct-base-mesh-unknown", reconstruct_with(base_mesh="poisson"), ValueError, None,
+         "vstree.reconstruct: parameter `base_mesh`: 'poisson' is not one of 'paper', 'winding'"),
     # estimate_normals
     case("normals-neighbours-too-many", normals_with(neighbours=300), vstree.VstreeError, BAD,
          "vstree_estimate_normals: parameter `neighbours`: 300: must be from 3 to 256"),

@@ -333,6 +333,7 @@ _METRICS = {"l2": 0, "l21": 1, "density": 2}
 _SAMPLINGS = {"vertices": 0, "faces": 1, "face_centers": 1}
 _ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
 _CLOSURES = {"auto": 0, "closed": 1, "open": 2}
+_BASE_MESHES = {"winding": 0, "paper": 1}
 _KEEP_TOPOLOGY = {"auto": 0, "on": 1, "off": 2}
 _ENUMS = {
     "tree_kind": _TREE_KINDS,
@@ -340,6 +341,7 @@ _ENUMS = {
     "sampling": _SAMPLINGS,
     "orient": _ORIENTATIONS,
     "closure": _CLOSURES,
+    "base_mesh": _BASE_MESHES,
     "keep_topology": _KEEP_TOPOLOGY,
 }
 _C_INTEGERS = {ctypes.c_uint32: ("uint32", 0, 2**32 - 1), ctypes.c_int32: ("int32", -(2**31), 2**31 - 1)}
@@ -600,6 +602,7 @@ _RECONSTRUCT_FIELDS = (
     "reorient_given",
     "threads",
     "closure",
+    "base_mesh",
 )
 _NORMAL_FIELDS = ("orient", "neighbours", "reorient_given", "threads")
 
@@ -626,9 +629,11 @@ def reconstruct(cloud, normals=None, progress=None, **params):
     missing normals are estimated and oriented outward. Parameters are the C struct's fields:
     ``error`` (the tree's L2 bound, the de-noising control; default 1e-5), ``max_levels``
     (refinement levels, 0-12; default 6), ``target_distance``, ``min_displaced``,
-    ``max_triangles``, ``max_grid_depth`` (4-20; default 10), ``closure`` ("auto", the default:
-    open where much of the closed surface is far from every point, as for a scan from one
-    side, | "closed" | "open"), ``trim`` (grid cells: every face farther goes; 0, the default,
+    ``max_triangles``, ``max_grid_depth`` (4-20; default 10), ``closure`` ("closed", the default | "open":
+    only the part of the surface the points support, for a scan from one side | "auto": open
+    where much of the closed surface is far from every point), ``base_mesh`` ("winding", the
+    default: the points' winding number decides inside and outside | "paper": the paper's
+    blended T-node planes), ``trim`` (grid cells: every face farther goes; 0, the default,
     trims only past an open scan's border), ``d_a``, ``d_d``, ``max_depth``, ``min_cell_size``, ``orient``
     ("propagate_outward" | "propagate" | "propagate_majority" | "unoriented"), ``neighbours``,
     ``reorient_given``, ``threads``.

@@ -217,7 +217,7 @@ class ReconstructParams(Structure):
         ("reorient_given", c_uint32),
         ("threads", c_uint32),
         ("closure", c_int32),
-        ("reserved", c_uint32),
+        ("base_mesh", c_int32),
     ]
 
 
