@@ -358,8 +358,13 @@ pub fn reconstruct(
     let typical_t_half = median(tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| n.half).collect());
     let inside_above = if params.trim > 0.0 || params.closure == Closure::Open { OPEN_SCAN_INSIDE } else { 0.5 };
     let far = OUTSIDE_BEYOND * unit.max(typical_t_half);
-    let softening = if params.base_mesh == BaseMesh::Winding { WINDING_SOFTENING * spacing } else { 0.0 };
-    let winding = winding::WindingNumber::new(&tree).softened(softening);
+    // A sparse cloud's leaves are smaller than the surface their few samples stand for: each
+    // sample stands for at least a square of the spacing (exactly that on a regular grid).
+    let (softening, min_sample_area) = match params.base_mesh {
+        BaseMesh::Winding => (WINDING_SOFTENING * spacing, spacing * spacing),
+        BaseMesh::Paper => (0.0, 0.0),
+    };
+    let winding = winding::WindingNumber::new(&tree, min_sample_area).softened(softening);
     let onto_samples = mls::SampleSurface::new(&tree.samples, &threads)?;
     let blend = implicit::PlaneBlend::new(&tree, SUPPORT_SCALE, 1.5 * grid.cell);
     let tolerance = FAR_FROM_SAMPLES * unit;

@@ -38,7 +38,8 @@ pub(crate) struct WindingNumber<'t> {
 }
 
 impl<'t> WindingNumber<'t> {
-    pub fn new(tree: &'t VsTree) -> WindingNumber<'t> {
+    /// `min_sample_area`: the least area a sample stands for (0: the leaves' cells alone say).
+    pub fn new(tree: &'t VsTree, min_sample_area: f32) -> WindingNumber<'t> {
         let n = tree.nodes.len();
         let mut flux = vec![Vec3::ZERO; n];
         let mut centre = vec![Vec3::ZERO; n];
@@ -54,7 +55,7 @@ impl<'t> WindingNumber<'t> {
                 }
                 let normal = samples.iter().map(|s| s.normal).sum::<Vec3>().normalize_or_zero();
                 centre[i] = samples.iter().map(|s| s.position).sum::<Vec3>() / samples.len() as f32;
-                area[i] = leaf_area(tree, i, normal);
+                area[i] = leaf_area(tree, i, normal).max(samples.len() as f32 * min_sample_area);
                 flux[i] = normal * area[i];
                 radius[i] = samples.iter().map(|s| s.position.distance(centre[i])).fold(0.0, f32::max);
                 continue;
@@ -182,7 +183,7 @@ mod tests {
         let torus = crate::shapes::torus(1.0, 0.35, 96, 48);
         let cloud = crate::shapes::sample_surface(&torus, 30_000, 3);
         let t = tree_of(&cloud);
-        let w = WindingNumber::new(&t);
+        let w = WindingNumber::new(&t, 0.0);
         for p in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, -1.0, 0.0), Vec3::new(-0.8, 0.6, 0.0).normalize()] {
             assert!((w.at(p) - 1.0).abs() < 0.15, "w({p}) = {}", w.at(p));
         }
@@ -200,8 +201,8 @@ mod tests {
         let cloud = crate::shapes::sample_surface(&sphere, 20_000, 5);
         let t = tree_of(&cloud);
         let spacing = (4.0 * std::f32::consts::PI / 20_000.0).sqrt();
-        let exact = WindingNumber::new(&t);
-        let soft = WindingNumber::new(&t).softened(spacing);
+        let exact = WindingNumber::new(&t, 0.0);
+        let soft = WindingNumber::new(&t, 0.0).softened(spacing);
         let (mut exact_worst, mut soft_worst) = (0.0f32, 0.0f32);
         for (p, n) in cloud.positions.iter().zip(cloud.normals.as_ref().unwrap()).step_by(997) {
             let q = *p + 0.01 * spacing * *n;
