@@ -177,10 +177,10 @@ pub(crate) fn project_vertices(s: &mut Surface, first: usize, onto: &SampleSurfa
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn sphere_samples(n: usize, radius: f32) -> Vec<TreeSample> {
+    pub(crate) fn sphere_samples(n: usize, radius: f32) -> Vec<TreeSample> {
         // A Fibonacci sphere: even spacing, exact outward normals.
         (0..n)
             .map(|i| {

@@ -26,6 +26,7 @@ mod implicit;
 mod leaf_fit;
 mod mls;
 mod refine;
+mod relax;
 mod support;
 mod winding;
 
@@ -477,6 +478,7 @@ pub fn reconstruct(
     // M0's vertices are off by up to their T-node's sag, later ones by less.
     let mls_reach = MLS_REACH * unit.max(typical_t_half);
     mls::project_vertices(&mut surface, 0, &onto_samples, mls_reach, &threads);
+    relax::improve(&mut surface, &onto_samples, mls_reach, &threads);
     let (mut rms, mut max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
     stats.base_error = rms;
     stats.stopped = RefinementStop::MaxLevels;
