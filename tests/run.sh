@@ -49,3 +49,6 @@ bash tests/platforms/run.sh
 
 echo "== Blender extension in bpy 4.2.23 and 5.0.1"
 bash tests/blender/run.sh
+
+echo "== Desktop Blender 4.3.2 and MeshLab 2022.02 (Debian 13 packages, in a chroot) under Xvfb"
+bash tests/hosts/run.sh

@@ -33,7 +33,9 @@ D13_BLENDER=4.3.2+dfsg-2
 D13_MESHLAB=2022.02+dfsg1-1
 # Debian's Blender runs on the system Python 3.13 and, unlike Blender's own builds, brings no
 # numpy (neither Depends nor Recommends); the extension needs it.
-D13_RUN="python3-numpy"
+# `apt install meshlab` brings its Recommends, which mmdebstrap leaves out: without them
+# MeshLab opens with a dialog about the plugins that need lib3ds, muparser and openctm.
+D13_RUN="python3-numpy chemical-mime-data lib3ds-1-3 libmpfr6 libmuparser2v5 libopenctm1 libqhull-r8.0 libxerces-c3.2t64"
 # The plugin's build dependencies (the same Qt 5 the package runs on).
 D13_BUILD="g++ make cmake qtbase5-dev libqt5opengl5-dev libglew-dev libeigen3-dev"
 
@@ -130,6 +132,7 @@ chroot_cmd=(unshare --mount --propagation private -- bash -euo pipefail -c '
     mount --rbind /dev "$c/dev"
     mount -t tmpfs tmpfs "$c/tmp"
     mkdir -p "$c/tmp/.X11-unix" "$c/vstree" "$c/shared-data"
+    mkdir -m 700 "$c/tmp/runtime"
     mount --bind /tmp/.X11-unix "$c/tmp/.X11-unix"
     mount --bind "$root" "$c/vstree"
     if [ -d "$data" ]; then
@@ -138,7 +141,7 @@ chroot_cmd=(unshare --mount --propagation private -- bash -euo pipefail -c '
     fi
     exec chroot "$c" /usr/bin/env -i PATH=/usr/local/bin:/usr/bin:/bin HOME=/vstree/target/hosts/home \
         LANG=C.UTF-8 DISPLAY="${DISPLAY:-}" LIBGL_ALWAYS_SOFTWARE=1 GALLIUM_DRIVER=llvmpipe \
-        LP_NUM_THREADS=2 XDG_RUNTIME_DIR=/tmp "$@"
+        LP_NUM_THREADS=2 XDG_RUNTIME_DIR=/tmp/runtime "$@"
 ' chroot_run)
 chroot_run() {
     local c=$1
@@ -174,8 +177,8 @@ for _ in $(seq 50); do
     sleep 0.2
 done
 xdpyinfo >/dev/null 2>&1 || { echo "Xvfb did not start:" >&2; cat "$work/xvfb.log" >&2; exit 1; }
-shot() { # shot FILE: the whole screen as PNG
-    xwd -root -silent | convert xwd:- "png:$1"
+shot() { # shot FILE: the whole screen as PNG (import, not xwd -root: that misses Qt's menus)
+    import -window root "$1"
 }
 
 if [[ $apps == *" blender "* ]]; then
@@ -268,6 +271,8 @@ if [[ $apps == *" blender "* ]]; then
     status=0
     wait "$blender_pid" || status=$?
     [ "$status" -eq 0 ] || fail "blender gui: blender exited with status $status (log: target/hosts/blender-gui/blender.log)"
+    # The GUI script's own checks (its output is in target/hosts/blender-gui/blender.log).
+    sed -n 's/^PASS \(blender gui: .*\)/ok   \1/p; s/^FAIL \(blender gui: .*\)/FAIL \1/p' "$results"
 fi
 
 # --- MeshLab --------------------------------------------------------------------------------
@@ -308,6 +313,115 @@ if [[ $apps == *" meshlab "* ]]; then
     else
         pass "meshlab: the plugin resolves every library and symbol against the package's"
     fi
+
+    step "MeshLab: the GUI under Xvfb, driven with xdotool"
+    ml=$work/meshlab
+    mkdir -p "$ml"
+    python3 tests/hosts/ply.py torus "$ml/torus.ply" # 3072 vertices, 6144 triangles, genus 1
+    "${chroot_cmd[@]}" "$d13" "$root" "$data" timeout 300 meshlab /vstree/target/hosts/meshlab/torus.ply \
+        >"$ml/meshlab.log" 2>&1 &
+    meshlab_pid=$!
+    app_pid=$meshlab_pid
+    # window NAME-REGEX SECONDS: prints the id of the visible window so named, once it is there.
+    window() {
+        local t=$((SECONDS + $2)) w
+        while [ $SECONDS -lt "$t" ]; do
+            w=$(xdotool search --onlyvisible --name "$1" 2>/dev/null | head -n 1 || true)
+            [ -n "$w" ] && echo "$w" && return 0
+            kill -0 "$meshlab_pid" 2>/dev/null || return 1
+            sleep 0.5
+        done
+        return 1
+    }
+    windows() { xdotool search --onlyvisible --name . 2>/dev/null | while read -r w; do xdotool getwindowname "$w"; done; }
+    if main=$(window "^MeshLab 2022\.02" 120); then
+        pass "meshlab: desktop MeshLab 2022.02 opens the model given on its command line"
+        sleep 3
+        # A window beside the main one at startup is a message box (a plugin that did not load).
+        others=$(windows | grep -v "^MeshLab 2022\.02" || true)
+        if [ -z "$others" ]; then
+            pass "meshlab: no message box at startup (every plugin loaded)"
+        else
+            fail "meshlab: startup shows other windows: $others"
+            shot "$work/shots/meshlab-startup.png"
+            xdotool key Return
+        fi
+        xdotool windowsize "$main" 1600 1000
+        sleep 1
+        xdotool mousemove 500 500 windowfocus --sync "$main"
+        # Filters (Alt+L) > the fourth entry, "Remeshing, Simplification and Reconstruction" >
+        # up from the top: Voronoi Filtering, Vertex Attribute Seam, VS-Tree Surface
+        # Reconstruction, VS-Tree Clustering Simplification (MeshLab sorts them by name).
+        xdotool key alt+l
+        sleep 1
+        xdotool key Down Down Down Down Right
+        sleep 1
+        xdotool key Up Up Up Up
+        sleep 1
+        shot "$work/shots/meshlab-filters-menu.png"
+        xdotool key Return
+        if dialog=$(window "^VS-Tree Clustering Simplification\$" 30); then
+            pass "meshlab: Filters > Remeshing, Simplification and Reconstruction > VS-Tree Clustering Simplification opens its dialog"
+            sleep 1
+            # "Percentage reduction (0..1)" = 0.1, then Apply (positions in the dialog).
+            xdotool mousemove --window "$dialog" 367 141 click 1
+            sleep 0.3
+            xdotool key ctrl+a
+            xdotool type --delay 50 0.1
+            sleep 0.3
+            xdotool mousemove --window "$dialog" 399 573 click 1
+            sleep 5
+            shot "$work/shots/meshlab-filter-dialog.png"
+            xdotool mousemove --window "$dialog" 137 573 click 1 # Close
+            sleep 1
+            # Export the current layer (Ctrl+E): the dialog names the layer, the file is checked.
+            xdotool mousemove 500 500 windowfocus --sync "$main"
+            xdotool key ctrl+e
+            if save=$(window '^Save "torus\.ply \(vstree\)" Layer$' 30); then
+                pass "meshlab: the new layer \"torus.ply (vstree)\" is the current one"
+                xdotool windowfocus --sync "$save"
+                xdotool type --delay 30 /vstree/target/hosts/meshlab/simplified.ply
+                xdotool key Return
+                if options=$(window "^Choose Saving Options" 30); then
+                    xdotool windowfocus --sync "$options"
+                    xdotool key Return
+                fi
+                for _ in $(seq 40); do
+                    [ -s "$ml/simplified.ply" ] && break
+                    sleep 0.5
+                done
+                sleep 1
+            else
+                fail "meshlab: no Save dialog for the layer \"torus.ply (vstree)\"; windows: $(windows | tr '\n' ';')"
+            fi
+            if [ -s "$ml/simplified.ply" ]; then
+                read -r _ v _ f _ closed _ euler <<<"$(python3 tests/hosts/ply.py stats "$ml/simplified.ply")"
+                echo "   exported layer: $v vertices, $f triangles, closed $closed, Euler characteristic $euler"
+                # 10% of 6144 triangles, within the library's 1%; the torus stays a torus.
+                if [ "$f" -ge 608 ] && [ "$f" -le 620 ] && [ "$v" -lt 3072 ] && [ "$closed" = 1 ] && [ "$euler" = 0 ]; then
+                    pass "meshlab: the new layer has 10% of the triangles, closed, genus 1"
+                else
+                    fail "meshlab: the new layer has $v vertices, $f triangles, closed $closed, Euler $euler"
+                fi
+            else
+                fail "meshlab: the new layer was not exported"
+            fi
+        else
+            fail "meshlab: the menu entry did not open the VS-Tree dialog; windows: $(windows | tr '\n' ';')"
+            shot "$work/shots/meshlab-no-dialog.png"
+        fi
+    else
+        fail "meshlab: no MeshLab window within 120 s (log: target/hosts/meshlab/meshlab.log)"
+    fi
+    kill "$meshlab_pid" 2>/dev/null || true
+    wait "$meshlab_pid" 2>/dev/null || true
+    app_pid=
 fi
 
+if [ "${VSTREE_HOSTS_SCREENSHOTS:-0}" = 1 ]; then
+    for f in blender-sidebar meshlab-filters-menu meshlab-filter-dialog; do
+        [ ! -f "$work/shots/$f.png" ] || cp "$work/shots/$f.png" docs/images/
+    done
+fi
+echo "screenshots: target/hosts/shots/ ($(cd "$work/shots" && echo *.png))"
 summary
