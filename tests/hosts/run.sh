@@ -106,9 +106,20 @@ make_chroot() {
     mkdir -p "$cache"
     t=$SECONDS
     echo "chroot $dir: building: $recipe"
-    if ! nice -n 10 mmdebstrap --quiet --variant=apt --include="${pkgs// /,}" --customize-hook="$hook" \
-        "$suite" "$dir.new" "$mirror" \
-        >"$work/mmdebstrap-$name.log" 2>&1; then
+    # A mirror being updated can fail a download: three tries.
+    local try ok=0
+    for try in 1 2 3; do
+        rm -rf "$dir.new"
+        if nice -n 10 mmdebstrap --variant=apt --include="${pkgs// /,}" --customize-hook="$hook" \
+            "$suite" "$dir.new" "$mirror" >"$work/mmdebstrap-$name.log" 2>&1; then
+            ok=1
+            break
+        fi
+        echo "mmdebstrap failed (try $try of 3):" >&2
+        grep -E "^(E|W):|Err:|Hash Sum|mismatch" "$work/mmdebstrap-$name.log" | head -n 10 >&2 || true
+        sleep 20
+    done
+    if [ "$ok" != 1 ]; then
         tail -n 30 "$work/mmdebstrap-$name.log" >&2
         rm -rf "$dir.new"
         return 1
@@ -151,7 +162,11 @@ chroot_run() {
 
 step "Debian 13 chroot"
 d13=$cache/debian13
-make_chroot debian13 trixie "blender=$D13_BLENDER meshlab=$D13_MESHLAB $D13_RUN $D13_BUILD"
+if ! make_chroot debian13 trixie "blender=$D13_BLENDER meshlab=$D13_MESHLAB $D13_RUN $D13_BUILD"; then
+    fail "the Debian 13 chroot could not be built (log: target/hosts/mmdebstrap-debian13.log)"
+    summary || true
+    exit 1
+fi
 echo "packages under test:"
 # shellcheck disable=SC2016 # dpkg-query's format
 chroot "$d13" dpkg-query -W -f='   ${Package} ${Version}\n' blender meshlab libgl1-mesa-dri libqt5core5t64 python3
