@@ -3,7 +3,8 @@ after `blender --command extension install-file`): generated meshes always, shar
 the shared data folder is mounted. Every check appends "PASS name" or "FAIL name: why" to the
 results file; the script itself exits 0 unless it cannot run at all.
 
-usage: blender -b --python blender_batch.py -- RESULTS SHARED_DATA_DIR
+usage: blender -b --python blender_batch.py -- RESULTS SHARED_DATA_DIR [LABEL]
+(LABEL, e.g. the system's name, starts every check's name.)
 """
 
 import os
@@ -14,12 +15,14 @@ import bmesh
 import bpy
 import numpy as np
 
-RESULTS, DATA = sys.argv[sys.argv.index("--") + 1:][:2]
+ARGS = sys.argv[sys.argv.index("--") + 1:]
+RESULTS, DATA = ARGS[:2]
+LABEL = (ARGS[2] + " ") if len(ARGS) > 2 else ""
 MODULE = "bl_ext.user_default.vstree"
 
 
 def record(ok, name, why=""):
-    line = ("PASS " if ok else "FAIL ") + "blender -b: " + name + ("" if ok else ": " + why)
+    line = ("PASS " if ok else "FAIL ") + LABEL + "blender -b: " + name + ("" if ok else ": " + why)
     print(("ok   " if ok else "FAIL ") + line[5:], flush=True)
     with open(RESULTS, "a") as f:
         f.write(line + "\n")

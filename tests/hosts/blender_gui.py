@@ -6,7 +6,8 @@ The script and the host take turns through two files in STATE_DIR: "state" (writ
 running, idle, sidebar, done) and "host" (written by run.sh: esc, shot, shot-done). Every check
 appends "PASS name" or "FAIL name: why" to RESULTS.
 
-usage: blender --python blender_gui.py -- RESULTS STATE_DIR
+usage: blender --python blender_gui.py -- RESULTS STATE_DIR [LABEL]
+(LABEL, e.g. the system's name, starts every check's name.)
 """
 
 import os
@@ -18,14 +19,16 @@ import traceback
 import bpy
 import numpy as np
 
-RESULTS, STATE_DIR = sys.argv[sys.argv.index("--") + 1:][:2]
+ARGS = sys.argv[sys.argv.index("--") + 1:]
+RESULTS, STATE_DIR = ARGS[:2]
+LABEL = (ARGS[2] + " ") if len(ARGS) > 2 else ""
 MODULE = "bl_ext.user_default.vstree"
 # No splash screen (it would take the first Esc); the preferences are not saved.
 bpy.context.preferences.view.show_splash = False
 
 
 def record(ok, name, why=""):
-    line = ("PASS " if ok else "FAIL ") + "blender gui: " + name + ("" if ok else ": " + why)
+    line = ("PASS " if ok else "FAIL ") + LABEL + "blender gui: " + name + ("" if ok else ": " + why)
     print(("ok   " if ok else "FAIL ") + line[5:], flush=True)
     with open(RESULTS, "a") as f:
         f.write(line + "\n")
@@ -200,7 +203,11 @@ def steps():
     if out is not None:
         select(out)
     space.shading.type = 'SOLID'
-    space.shading.color_type = 'VERTEX'  # "Attribute" in the UI
+    try:
+        space.shading.color_type = 'VERTEX'  # "Attribute" in the UI of 4.x
+    except TypeError:
+        space.shading.color_type = 'ATTRIBUTE'
+
     src.data.color_attributes.active_color = src.data.color_attributes["vstree_cluster"]
     with bpy.context.temp_override(**view3d()):
         bpy.ops.view3d.view_all()
