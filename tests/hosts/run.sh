@@ -129,7 +129,17 @@ make_chroot() {
             break
         fi
         echo "mmdebstrap failed (try $try of 3):" >&2
-        grep -E "^(E|W):|Err:|Hash Sum|mismatch" "$work/mmdebstrap-$name.log" | head -n 10 >&2 || true
+        grep -E "^E:|Err:|Hash Sum|mismatch" "$work/mmdebstrap-$name.log" | head -n 10 >&2 || true
+        # A mirror that serves a suite's Release after its Valid-Until date (a stale mirror or
+        # snapshot: unstable's Release is valid for a week) is taken as it is, said aloud; the
+        # signature is still checked.
+        if grep -q "InRelease is expired" "$work/mmdebstrap-$name.log" &&
+            [[ " ${opts[*]} " != *Check-Valid-Until* ]]; then
+            echo "WARNING: $(grep -o "Release file for .* is expired ([^)]*)" "$work/mmdebstrap-$name.log" | head -n 1);" \
+                "building from it anyway (Acquire::Check-Valid-Until false)" >&2
+            opts+=(--aptopt='Acquire::Check-Valid-Until "false"')
+            continue
+        fi
         [ "$try" = 3 ] || sleep 20
     done
     if [ "$ok" != 1 ]; then
@@ -340,11 +350,22 @@ test_meshlab() {
     cp "$libvstree" "$prefix/lib/libvstree.so.0"
     ln -sf libvstree.so.0 "$prefix/lib/libvstree.so"
     cp include/vstree.h "$prefix/include/"
-    # The scalar type MeshLab was built with: its plugins' getMLVersion() returns it as the
-    # pair's bool (true: double), a constant stored at offset 0x20 of the returned pair.
-    # Debian's 2022.02 is float, pymeshlab's wheels double; a plugin of the other is refused.
-    scalar=$(objdump -d --no-show-raw-insn "$c$ml_lib/plugins/libfilter_clean.so" |
+    # The scalar type MeshLab was built with, read from one of its own plugins: getMLVersion()
+    # returns (version, builtWithDoublePrecision()), the latter comparing the string of
+    # MESHLAB_SCALAR with "double". 2022.02's compiler folds it to a constant stored in the
+    # returned pair (offset 0x20); 2025.07's keeps the comparison, with the literals "float"
+    # and "double" (one "double" only when MESHLAB_SCALAR is double). Debian's 2022.02 is
+    # float, pymeshlab's wheels double; a plugin of the other type is refused at load time.
+    local ref=$c$ml_lib/plugins/libfilter_clean.so
+    scalar=$(objdump -d --no-show-raw-insn "$ref" |
         sed -n '/getMLVersion.*>:$/,/ret/p' | sed -n 's/.*movb *\$0x\([01]\),0x20(%rdi).*/\1/p' | head -n 1)
+    if [ -z "$scalar" ]; then
+        if strings -n 5 "$ref" | grep -qx float; then
+            scalar=0
+        elif strings -n 5 "$ref" | grep -qx double; then
+            scalar=1
+        fi
+    fi
     case $scalar in
         0) scalar=float ;;
         1) scalar=double ;;
@@ -414,16 +435,20 @@ test_meshlab() {
         if dialog=$(window "^VS-Tree Clustering Simplification\$" 30); then
             pass "$sys meshlab: Filters > Remeshing, Simplification and Reconstruction > VS-Tree Clustering Simplification opens its dialog"
             sleep 1
-            # "Percentage reduction (0..1)" = 0.1, then Apply (positions in the dialog).
-            xdotool mousemove --window "$dialog" 367 141 click 1
+            # "Percentage reduction (0..1)" = 0.1 (the second field from the top), then Apply
+            # (bottom right; Close is bottom left). 2025.07's dialog is taller: the buttons
+            # are placed from its bottom edge.
+            local WIDTH HEIGHT
+            eval "$(xdotool getwindowgeometry --shell "$dialog" | grep -E '^(WIDTH|HEIGHT)=')"
+            xdotool mousemove --window "$dialog" 367 136 click 1
             sleep 0.3
             xdotool key ctrl+a
             xdotool type --delay 50 0.1
             sleep 0.3
-            xdotool mousemove --window "$dialog" 399 573 click 1
+            xdotool mousemove --window "$dialog" $((WIDTH - 139)) $((HEIGHT - 22)) click 1
             sleep 5
             shot "$work/shots/$sys-meshlab-filter-dialog.png"
-            xdotool mousemove --window "$dialog" 137 573 click 1 # Close
+            xdotool mousemove --window "$dialog" 137 $((HEIGHT - 22)) click 1 # Close
             sleep 1
             # Export the current layer (Ctrl+E): the dialog names the layer, the file is checked.
             xdotool mousemove 500 500 windowfocus --sync "$main"
@@ -504,7 +529,7 @@ if [[ $systems == *" sid "* ]]; then
     step "$sys: Debian unstable chroot (not pinned; rebuilt weekly)"
     # Recommends included, as `apt install` does (MeshLab's plugins need theirs).
     if ! make_chroot "$sys" sid "blender meshlab python3-numpy $BUILD_DEPS" 7 'APT::Install-Recommends "true"'; then
-        reason=$(grep -E "^(E|W):|Err:" "$work/mmdebstrap-$sys.log" | head -n 3 | tr '\n' ' ')
+        reason=$(grep -E "^E:|Err:" "$work/mmdebstrap-$sys.log" | head -n 3 | tr '\n' ' ')
         skip "$sys: the Debian unstable chroot could not be built (mirror churn?): ${reason:-see target/hosts/mmdebstrap-$sys.log}"
     else
         print_versions
@@ -518,5 +543,5 @@ if [[ $systems == *" sid "* ]]; then
     fi
 fi
 
-echo "screenshots: target/hosts/shots/ ($(cd "$work/shots" && echo *.png))"
+echo "screenshots: target/hosts/shots/: $(find "$work/shots" -name '*.png' -printf '%f ')"
 summary
