@@ -245,7 +245,7 @@ test_blender() {
         status=$?
     printf '   %s\n' "$out"
     # Enabling (-e) prints "Error: ..." but exits 0 when the add-on fails to import.
-    if [ "$status" -eq 0 ] && echo "$out" | grep -q '^STATUS Installed "vstree"' && ! echo "$out" | grep -q '^Error'; then
+    if [ "$status" -eq 0 ] && grep -q '^STATUS Installed "vstree"' <<<"$out" && ! grep -q '^Error' <<<"$out"; then
         pass "$sys blender: extension install-file installs and enables the zip"
     else
         fail "$sys blender: extension install-file (status $status) did not install and enable the zip cleanly"
@@ -284,7 +284,7 @@ test_blender() {
         sleep 2
         shot "$work/shots/$sys-blender-progress.png"
         # Esc, typed as a user does: pointer over the 3D view, the key through XTEST.
-        win=$(xdotool search --onlyvisible --class blender | head -n 1)
+        win=$(xdotool search --onlyvisible --class blender | head -n 1 || true)
         xdotool mousemove 700 500
         xdotool windowfocus --sync "$win" 2>/dev/null || true
         xdotool key Escape
@@ -360,9 +360,12 @@ test_meshlab() {
     scalar=$(objdump -d --no-show-raw-insn "$ref" |
         sed -n '/getMLVersion.*>:$/,/ret/p' | sed -n 's/.*movb *\$0x\([01]\),0x20(%rdi).*/\1/p' | head -n 1)
     if [ -z "$scalar" ]; then
-        if strings -n 5 "$ref" | grep -qx float; then
+        # (not `strings | grep -q`: grep's early exit can fail the pipe under pipefail)
+        local literals
+        literals=$(strings -n 5 "$ref")
+        if grep -qx float <<<"$literals"; then
             scalar=0
-        elif strings -n 5 "$ref" | grep -qx double; then
+        elif grep -qx double <<<"$literals"; then
             scalar=1
         fi
     fi
