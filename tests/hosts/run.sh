@@ -174,11 +174,13 @@ chroot_cmd=(unshare --mount --propagation private -- bash -euo pipefail -c '
     fi
     exec chroot "$c" /usr/bin/env -i PATH=/usr/local/bin:/usr/bin:/bin HOME="$home" \
         LANG=C.UTF-8 DISPLAY="${DISPLAY:-}" LIBGL_ALWAYS_SOFTWARE=1 GALLIUM_DRIVER=llvmpipe \
-        LP_NUM_THREADS=2 XDG_RUNTIME_DIR=/tmp/runtime "$@"
+        LP_NUM_THREADS=2 XDG_RUNTIME_DIR=/tmp/runtime PYTHONDONTWRITEBYTECODE=1 "$@"
 ' chroot_run)
-# in_chroot COMMAND...: runs COMMAND in the current system's chroot ($c, $sys).
+# in_chroot COMMAND...: runs COMMAND in the current system's chroot ($c, $sys). For a command
+# in the background use "${chroot_cmd[@]}" "$c" "$chome" "$root" "$data" COMMAND... & instead:
+# a function run with & is a subshell, and $! would be that subshell, not the command.
 in_chroot() {
-    "${chroot_cmd[@]}" "$c" "/vstree/target/hosts/$sys/home" "$root" "$data" "$@"
+    "${chroot_cmd[@]}" "$c" "$chome" "$root" "$data" "$@"
 }
 
 # --- X server -------------------------------------------------------------------------------
@@ -276,7 +278,8 @@ test_blender() {
         done
         return 1
     }
-    in_chroot timeout 900 blender --window-geometry 0 0 1600 1000 --python /vstree/tests/hosts/blender_gui.py \
+    "${chroot_cmd[@]}" "$c" "$chome" "$root" "$data" \
+        timeout 900 blender --window-geometry 0 0 1600 1000 --python /vstree/tests/hosts/blender_gui.py \
         -- /vstree/target/hosts/results.txt "/vstree/target/hosts/$sys/blender-gui" "$sys" >"$gui/blender.log" 2>&1 &
     blender_pid=$!
     app_pid=$blender_pid
@@ -407,7 +410,8 @@ test_meshlab() {
     ml=$work/$sys/meshlab
     mkdir -p "$ml"
     python3 tests/hosts/ply.py torus "$ml/torus.ply" # 3072 vertices, 6144 triangles, genus 1
-    in_chroot timeout 300 meshlab "/vstree/target/hosts/$sys/meshlab/torus.ply" >"$ml/meshlab.log" 2>&1 &
+    "${chroot_cmd[@]}" "$c" "$chome" "$root" "$data" \
+        timeout 300 meshlab "/vstree/target/hosts/$sys/meshlab/torus.ply" >"$ml/meshlab.log" 2>&1 &
     app_pid=$!
     if main=$(window "^MeshLab ${ml_series//./\\.}" 120); then
         pass "$sys meshlab: desktop MeshLab $ml_series opens the model given on its command line"
@@ -509,6 +513,7 @@ print_versions() {
 if [[ $systems == *" debian13 "* ]]; then
     sys=debian13
     c=$cache/$sys
+    chome=/vstree/target/hosts/$sys/home
     mkdir -p "$work/$sys/home"
     step "$sys: Debian 13 chroot"
     if ! make_chroot "$sys" trixie "blender=$D13_BLENDER meshlab=$D13_MESHLAB $D13_RUN $BUILD_DEPS"; then
@@ -528,6 +533,7 @@ fi
 if [[ $systems == *" sid "* ]]; then
     sys=sid
     c=$cache/$sys
+    chome=/vstree/target/hosts/$sys/home
     mkdir -p "$work/$sys/home"
     step "$sys: Debian unstable chroot (not pinned; rebuilt weekly)"
     # Recommends included, as `apt install` does (MeshLab's plugins need theirs).
