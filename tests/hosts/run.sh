@@ -494,7 +494,10 @@ test_meshlab() {
             shot "$work/shots/$sys-meshlab-no-dialog.png"
         fi
     else
-        fail "$sys meshlab: no MeshLab window within 120 s (log: target/hosts/$sys/meshlab/meshlab.log)"
+        # (a plugin MeshLab refuses shows its message box before the main window)
+        shot "$work/shots/$sys-meshlab-no-window.png"
+        fail "$sys meshlab: no MeshLab window within 120 s; windows: $(windows | tr '\n' ';') (screenshot" \
+            "target/hosts/shots/$sys-meshlab-no-window.png, log target/hosts/$sys/meshlab/meshlab.log)"
     fi
     kill "$app_pid" 2>/dev/null || true
     wait "$app_pid" 2>/dev/null || true
