@@ -49,3 +49,6 @@ bash tests/platforms/run.sh
 
 echo "== Blender extension in bpy 4.2.23 and 5.0.1"
 bash tests/blender/run.sh
+
+echo "== Desktop Blender and MeshLab under Xvfb: Debian 13 (4.3.2, 2022.02, pinned) and unstable (5.2, 2025.07), in chroots"
+bash tests/hosts/run.sh

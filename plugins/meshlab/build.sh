@@ -10,6 +10,7 @@
 # usage: plugins/meshlab/build.sh <2022.2.post4|2025.7.post1>
 # env:   ML_FETCH=pool (default: Debian pool path) | apt (apt-get source with a temporary deb-src)
 #        JOBS=2   SKIP_APT=1 (do not touch apt)   VSTREE_NO_BUILD=1 (reuse target/release)
+#        HEADERS_ONLY=1: steps 2-3 only (tests/hosts builds against desktop MeshLab's own library)
 # Target: Debian 12 bookworm amd64 with python3 3.11; apt needs root.
 set -euo pipefail
 
@@ -65,7 +66,7 @@ step "1/7 apt packages"
 PKGS=(ca-certificates curl xz-utils g++ make cmake
 	qtbase5-dev libqt5opengl5-dev libglew-dev libeigen3-dev
 	python3 python3-venv libgl1 libopengl0 libx11-6 libxcb1 libfontconfig1 libfreetype6)
-if [ "${SKIP_APT:-0}" != 1 ]; then
+if [ "${SKIP_APT:-0}" != 1 ] && [ "${HEADERS_ONLY:-0}" != 1 ]; then
 	missing=()
 	for p in "${PKGS[@]}"; do
 		dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -110,6 +111,10 @@ if [ ! -f "$SRC/.unpacked-$ORIG_SHA256" ]; then
 	touch "$SRC/.unpacked-$ORIG_SHA256"
 fi
 [ "$(tr -d '[:space:]' <"$SRC/ML_VERSION")" = "$ML_VERSION_FILE" ] || { echo "bad ML_VERSION in $SRC" >&2; exit 1; }
+if [ "${HEADERS_ONLY:-0}" = 1 ]; then
+	echo "=== headers of MeshLab $ML_VERSION_FILE ($DEB_SRC_VERSION): $SRC"
+	exit 0
+fi
 
 step "4/7 venv + pymeshlab==$VER (hash-pinned)"
 mkdir -p "$OUT"
