@@ -122,6 +122,28 @@ fn a_sparse_torus_keeps_its_handle() {
 }
 
 #[test]
+fn normals_that_all_point_inward_are_turned_out_for_a_closed_surface() {
+    let outward = sphere_points(20_000, |_| true);
+    let inward =
+        Mesh::from_points(outward.positions.clone(), outward.normals.as_ref().map(|n| n.iter().map(|&v| -v).collect()));
+    let (mesh, stats) = run(&inward, &ReconstructParams::default());
+    assert_eq!(stats.normals.orient.map(|o| o.flipped), Some(20_000));
+    let report = topology::analyze(&mesh);
+    assert!(report.is_watertight() && report.genus() == Some(0) && report.components == 1, "{report:?}");
+    let off = mesh.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max);
+    assert!(off < 0.02, "a vertex {off} off the sphere");
+    // Given outward normals are kept; so are those of an open output, where they face the
+    // scanner whatever their flux: the inside of a bowl, scanned from within.
+    assert_eq!(run(&outward, &ReconstructParams::default()).1.normals.orient, None);
+    let dome = sphere_points(10_000, |p| p.z > 0.0);
+    let bowl =
+        Mesh::from_points(dome.positions.clone(), dome.normals.as_ref().map(|n| n.iter().map(|&v| -v).collect()));
+    let (mesh, stats) = run(&bowl, &ReconstructParams { closure: Closure::Open, ..Default::default() });
+    assert_eq!(stats.normals.orient, None);
+    assert!(topology::analyze(&mesh).boundary_edges > 0);
+}
+
+#[test]
 fn real_shapes_of_known_genus() {
     let Some(kitten) = common::load("kitten.xyz") else { return };
     assert_closed_reconstruction("kitten", &kitten, 1);

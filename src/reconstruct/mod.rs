@@ -36,7 +36,7 @@ pub use support::Closure;
 use crate::distance::{PointBvh, TriangleBvh};
 use crate::error::{shown, Error, Result};
 use crate::mesh::Mesh;
-use crate::normals::{self, NormalParams, NormalsReport};
+use crate::normals::{self, NormalParams, NormalsReport, OrientReport};
 use crate::polygonize::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
 use crate::progress::{Progress, Threads};
 use crate::samples::SampleSet;
@@ -91,6 +91,11 @@ const WINDING_SOFTENING: f32 = 1.0;
 /// is in doubt, and the nearest samples' tangent planes decide the side instead: about 1
 /// inside and 0 outside a closed surface, it sinks towards 0 near the border of an open scan.
 const WINDING_DOUBT: f32 = 0.25;
+/// Given normals whose flux of `p - c` (`c` the centroid) is below this share of its absolute
+/// sum point inward, and a closed reconstruction flips them all. Through a closed surface's
+/// outward normals that flux is 3 times its volume (the divergence theorem), so positive
+/// whatever the shape: measured +0.7 to +1 on outward clouds, -0.92 on an inward armadillo.
+const INWARD_FLUX: f64 = -0.5;
 /// Farthest a vertex is moved onto the samples' local fit ([`mls`]), in units (grid cells or
 /// sample spacings) or typical T-node half sizes, whichever is larger: M0's vertices start up
 /// to a T-node's sag off the surface; a longer move would reach another part of it.
@@ -328,6 +333,14 @@ pub fn reconstruct(
     let mut oriented = Mesh::from_points(cloud.positions.clone(), cloud.normals.clone());
     let normal_params = NormalParams { threads: params.threads, ..params.normals };
     stats.normals = normals::ensure_normals(&mut oriented, &normal_params, &mut progress.stage(0.0, 0.15))?;
+    let kept_given = stats.normals.estimated == 0 && stats.normals.orient.is_none();
+    if kept_given && params.closure == Closure::Closed {
+        if let Some(flipped) = turn_inward_normals_out(&mut oriented) {
+            let points = oriented.positions.len();
+            stats.normals.orient =
+                Some(OrientReport { components: 1, largest_component: points, undecided_components: 0, flipped });
+        }
+    }
     let samples = SampleSet::from_cloud(&oriented)?;
     drop(oriented);
     stats.seconds_normals = start.elapsed().as_secs_f64();
@@ -582,6 +595,23 @@ fn paper_function(
     } else {
         blended.min(0.0) - (d - tolerance)
     }
+}
+
+/// Flips every normal of `cloud` when together they point inward (see [`INWARD_FLUX`]);
+/// returns how many were flipped.
+fn turn_inward_normals_out(cloud: &mut Mesh) -> Option<usize> {
+    let normals = cloud.normals.as_mut()?;
+    let n = cloud.positions.len().max(1) as f64;
+    let centroid = cloud.positions.iter().map(|p| p.as_dvec3()).sum::<glam::DVec3>() / n;
+    let (flux, absolute) = cloud.positions.iter().zip(normals.iter()).fold((0.0, 0.0), |(f, a), (p, m)| {
+        let d = m.as_dvec3().dot(p.as_dvec3() - centroid);
+        (f + d, a + d.abs())
+    });
+    if !(absolute > 0.0 && flux < INWARD_FLUX * absolute) {
+        return None;
+    }
+    normals.iter_mut().for_each(|m| *m = -*m);
+    Some(normals.len())
 }
 
 /// The grid the base mesh is polygonised on: cells the size of the deepest T-node's cube, but
