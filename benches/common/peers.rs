@@ -9,15 +9,17 @@ use std::process::{Command, Stdio};
 /// Runs `python3 benches/<script> <args>` from `root` and returns its stdout records, each
 /// split at tabs. Fails when the script cannot start, fails, or prints no record.
 pub fn run(root: &Path, script: &str, args: &[OsString]) -> Result<Vec<Vec<String>>, String> {
+    // Messages name the script as `benches/<script>`: they end up in the committed reports.
+    let shown = format!("benches/{script}");
     let script = root.join("benches").join(script);
     let output = Command::new("python3")
         .arg(&script)
         .args(args)
         .stderr(Stdio::inherit())
         .output()
-        .map_err(|e| format!("cannot run python3 {}: {e}", script.display()))?;
+        .map_err(|e| format!("cannot run python3 {shown}: {e}"))?;
     if !output.status.success() {
-        return Err(format!("{} failed ({})", script.display(), output.status));
+        return Err(format!("{shown} failed ({})", output.status));
     }
     let records: Vec<Vec<String>> = String::from_utf8_lossy(&output.stdout)
         .lines()
@@ -25,7 +27,7 @@ pub fn run(root: &Path, script: &str, args: &[OsString]) -> Result<Vec<Vec<Strin
         .map(|l| l.split('\t').map(str::to_string).collect())
         .collect();
     if records.is_empty() {
-        return Err(format!("{} reported nothing", script.display()));
+        return Err(format!("{shown} reported nothing"));
     }
     Ok(records)
 }
