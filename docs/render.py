@@ -1,32 +1,43 @@
 """Offscreen z-buffer renderer for the pictures in the docs (numpy + pillow only).
 
 Usage: python docs/render.py mesh.ply out.png [azimuth_deg] [elevation_deg] [wire]
+       python docs/render.py a.ply,b.ply,... out.png [...]   (side by side, same view)
 Reads binary little-endian or ASCII PLY as vstree writes it. Back faces are drawn brown."""
 import sys, struct, numpy as np
 from PIL import Image
 
+TYPES = {'float': '<f4', 'float32': '<f4', 'double': '<f8', 'float64': '<f8', 'uchar': 'u1', 'uint8': 'u1',
+         'char': 'i1', 'int8': 'i1', 'ushort': '<u2', 'uint16': '<u2', 'short': '<i2', 'int16': '<i2',
+         'uint': '<u4', 'uint32': '<u4', 'int': '<i4', 'int32': '<i4'}
+
 def read_ply(path):
+    """Vertices (n, 3) and triangles (m, 3) of a triangle PLY: ASCII or binary little endian,
+    any scalar vertex properties (x, y, z first), faces as a list of 3 indices."""
     data = open(path, 'rb').read()
     head_end = data.index(b'end_header') + len(b'end_header\n')
     header = data[:head_end].decode().splitlines()
-    nv = nf = 0; props = []; fmt = 'binary_little_endian'; cur = None
+    nv = nf = 0; props = []; fmt = 'binary_little_endian'; cur = None; count_t = index_t = 'u1'
     for l in header:
         t = l.split()
+        if not t: continue
         if t[0] == 'format': fmt = t[1]
         if t[0] == 'element': cur = t[1]; n = int(t[2]); nv = n if cur == 'vertex' else nv; nf = n if cur == 'face' else nf
-        if t[0] == 'property' and cur == 'vertex': props.append(t[-1])
+        if t[0] == 'property' and cur == 'vertex': props.append((t[-1], TYPES[t[1]]))
+        if t[0] == 'property' and cur == 'face' and t[1] == 'list': count_t, index_t = TYPES[t[2]], TYPES[t[3]]
     body = data[head_end:]
     if fmt == 'ascii':
         lines = body.decode().split('\n')
         V = np.array([[float(x) for x in lines[i].split()[:3]] for i in range(nv)])
         F = np.array([[int(x) for x in lines[nv+i].split()[1:4]] for i in range(nf)]) if nf else np.zeros((0,3),int)
         return V, F
-    V = np.frombuffer(body[:nv*4*len(props)], dtype='<f4').reshape(nv, len(props))[:, :3].astype(float)
-    off = nv*4*len(props)
-    F = np.frombuffer(body[off:off+nf*13], dtype=np.dtype([('n','u1'),('i','<u4',(3,))]))['i'].astype(int) if nf else np.zeros((0,3),int)
+    vt = np.dtype([(name, typ) for name, typ in props])
+    vs = np.frombuffer(body[:nv*vt.itemsize], dtype=vt)
+    V = np.stack([vs['x'], vs['y'], vs['z']], 1).astype(float)
+    ft = np.dtype([('n', count_t), ('i', index_t, (3,))])
+    F = np.frombuffer(body[nv*vt.itemsize:nv*vt.itemsize + nf*ft.itemsize], dtype=ft)['i'].astype(int) if nf else np.zeros((0,3),int)
     return V, F
 
-def render(V, F, out, az=30, el=20, wire=False, W=700):
+def render(V, F, az=30, el=20, wire=False, W=700):
     a, e = np.radians(az), np.radians(el)
     R = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
     R = np.array([[1, 0, 0], [0, np.cos(e), -np.sin(e)], [0, np.sin(e), np.cos(e)]]) @ R
@@ -64,7 +75,9 @@ def render(V, F, out, az=30, el=20, wire=False, W=700):
             img[ys, xs] = cc; img[ys[edge], xs[edge]] = (30, 30, 30)
         else:
             img[ys, xs] = cc
-    Image.fromarray(img).save(out)
+    return img
 
-V, F = read_ply(sys.argv[1])
-render(V, F, sys.argv[2], float(sys.argv[3]) if len(sys.argv) > 3 else 30, float(sys.argv[4]) if len(sys.argv) > 4 else 20, len(sys.argv) > 5)
+az = float(sys.argv[3]) if len(sys.argv) > 3 else 30
+el = float(sys.argv[4]) if len(sys.argv) > 4 else 20
+images = [render(*read_ply(path), az, el, len(sys.argv) > 5) for path in sys.argv[1].split(',')]
+Image.fromarray(np.concatenate(images, axis=1)).save(sys.argv[2])
