@@ -10,16 +10,19 @@
 #ifndef VSTREE_MESHLAB_COMPAT_H
 #define VSTREE_MESHLAB_COMPAT_H
 
-#if __has_include(<common/plugins/interfaces/filter_plugin.h>)
-#include <common/plugins/interfaces/filter_plugin.h>
-#define VSTREE_MESHLAB_2020 0
-#else
+// VSTREE_MESHLAB_2020 is set by CMakeLists.txt from the headers found (not with __has_include:
+// moc, which reads this header too, does not evaluate it).
+#ifndef VSTREE_MESHLAB_2020
+#error "VSTREE_MESHLAB_2020 must be defined (0 or 1); CMakeLists.txt sets it"
+#endif
+#if VSTREE_MESHLAB_2020
 #include <common/interfaces.h>
 #include <common/mlexception.h>
-#define VSTREE_MESHLAB_2020 1
 using FilterPlugin = MeshFilterInterface;
 using ActionIDType = MeshFilterInterface::FilterIDType;
 #define FILTER_PLUGIN_IID MESH_FILTER_INTERFACE_IID
+#else
+#include <common/plugins/interfaces/filter_plugin.h>
 #endif
 
 #endif
