@@ -47,6 +47,8 @@ D13_RUN="python3-numpy chemical-mime-data lib3ds-1-3 libmpfr6 libmuparser2v5 lib
 BUILD_DEPS="g++ make cmake qtbase5-dev libqt5opengl5-dev libglew-dev libeigen3-dev"
 
 step() { echo "== [$((SECONDS - T0)) s] $*"; }
+# shellcheck source=tests/hosts/meshlab_scalar.sh
+source tests/hosts/meshlab_scalar.sh
 
 if [ "$(id -u)" -ne 0 ]; then
     echo "tests/hosts/run.sh: needs root (mmdebstrap, chroot, mounts)" >&2
@@ -353,33 +355,12 @@ test_meshlab() {
     cp "$libvstree" "$prefix/lib/libvstree.so.0"
     ln -sf libvstree.so.0 "$prefix/lib/libvstree.so"
     cp include/vstree.h "$prefix/include/"
-    # The scalar type MeshLab was built with, read from one of its own plugins: getMLVersion()
-    # returns (version, builtWithDoublePrecision()), the latter comparing the string of
-    # MESHLAB_SCALAR with "double". 2022.02's compiler folds it to a constant stored in the
-    # returned pair (offset 0x20); 2025.07's keeps the comparison, with the literals "float"
-    # and "double" (one "double" only when MESHLAB_SCALAR is double). Debian's 2022.02 is
-    # float, pymeshlab's wheels double; a plugin of the other type is refused at load time.
-    local ref=$c$ml_lib/plugins/libfilter_clean.so
-    scalar=$(objdump -d --no-show-raw-insn "$ref" |
-        sed -n '/getMLVersion.*>:$/,/ret/p' | sed -n 's/.*movb *\$0x\([01]\),0x20(%rdi).*/\1/p' | head -n 1)
-    if [ -z "$scalar" ]; then
-        # (not `strings | grep -q`: grep's early exit can fail the pipe under pipefail)
-        local literals
-        literals=$(strings -n 5 "$ref")
-        if grep -qx float <<<"$literals"; then
-            scalar=0
-        elif grep -qx double <<<"$literals"; then
-            scalar=1
-        fi
+    # The scalar type MeshLab was built with, read from one of its own plugins
+    # (tests/hosts/meshlab_scalar.sh).
+    if ! scalar=$(meshlab_scalar "$c$ml_lib/plugins/libfilter_clean.so"); then
+        fail "$sys meshlab: cannot tell whether MeshLab $ml_version is built with float or double"
+        return 0
     fi
-    case $scalar in
-        0) scalar=float ;;
-        1) scalar=double ;;
-        *)
-            fail "$sys meshlab: cannot tell whether MeshLab $ml_version is built with float or double"
-            return 0
-            ;;
-    esac
     echo "MeshLab $ml_version: built with $scalar scalars"
     in_chroot cmake -S /vstree/plugins/meshlab -B "/vstree/target/hosts/$sys/meshlab-build" \
         -DCMAKE_BUILD_TYPE=Release -DMESHLAB_SRC_DIR="/vstree/$ml_src" -DMESHLAB_LIB_DIR="$ml_lib" \
