@@ -529,8 +529,9 @@ void FilterVstreePlugin::initParameterSet(QAction* a, MeshModel& m, RichParamete
 	params = parameters(ID(a), m);
 }
 
-// 2020.09 has no error exceptions: the message goes to errorMessage (meshlabserver prints
-// "Problem with filter") and the outputs to the log.
+// 2020.09 has no error exceptions: the message goes to errorMessage (the GUI's error box) and
+// to the log, since meshlabserver prints only "Problem with filter" and the log; the outputs
+// go to the log too.
 bool FilterVstreePlugin::applyFilter(QAction* action, MeshDocument& md, const RichParameterList& par, vcg::CallBackPos* cb)
 {
 	try {
@@ -539,6 +540,7 @@ bool FilterVstreePlugin::applyFilter(QAction* action, MeshDocument& md, const Ri
 		return true;
 	} catch (const MLException& e) {
 		errorMessage = QString::fromLocal8Bit(e.what());
+		logf("%s", e.what());
 		return false;
 	}
 }
