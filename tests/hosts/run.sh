@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # The plugins in the desktop applications users open, under Xvfb with Mesa's software OpenGL.
 #   debian13: Blender 4.3.2 and MeshLab 2022.02, the packages of Debian 13 (trixie), pinned.
+#   debian12: MeshLab 2020.09, Debian 12's package, on the host itself when it is Debian 12
+#             (tests/hosts/meshlab2020.sh: the plugin built for 2020.09's interface,
+#             meshlabserver applies both filters from .mlx scripts; skipped on other hosts).
 #   sid:      Blender and MeshLab of Debian unstable, not pinned (the versions are printed); a
 #             chroot that cannot be built (mirror churn) is reported as skipped with the reason.
 # Each system is a chroot made with mmdebstrap from Debian's mirror and kept outside the clone,
@@ -18,7 +21,7 @@
 # Installs what it needs on the host (Debian 12 or later, as root). Each check prints ok/FAIL;
 # the last line is "N passed, M failed" and the status is non-zero when anything failed.
 # env: DEBIAN_MIRROR (default http://deb.debian.org/debian), JOBS=2,
-#      VSTREE_HOSTS_SYSTEMS="debian13 sid" (the default: both),
+#      VSTREE_HOSTS_SYSTEMS="debian13 sid debian12" (the default: all three),
 #      VSTREE_HOSTS_APPS="blender meshlab" (the default: both),
 #      VSTREE_HOSTS_SCREENSHOTS=1 copies Debian 13's screenshots into docs/images/ (they always
 #      go to target/hosts/shots/).
@@ -32,7 +35,7 @@ mirror=${DEBIAN_MIRROR:-http://deb.debian.org/debian}
 cache=${XDG_CACHE_HOME:-$HOME/.cache}/vstree/chroots
 work=$root/target/hosts
 data=$(cd "$root/.." && pwd)/shared/data
-systems=" ${VSTREE_HOSTS_SYSTEMS:-debian13 sid} "
+systems=" ${VSTREE_HOSTS_SYSTEMS:-debian13 sid debian12} "
 apps=" ${VSTREE_HOSTS_APPS:-blender meshlab} "
 
 # Debian 13 packages under test, pinned.
@@ -542,6 +545,16 @@ if [[ $systems == *" sid "* ]]; then
                 *) fail "$sys meshlab: $(chroot "$c" dpkg-query -W -f='${Version}' meshlab) has no headers recipe in plugins/meshlab/build.sh" ;;
             esac
         fi
+    fi
+fi
+
+if [[ $systems == *" debian12 "* ]] && [[ $apps == *" meshlab "* ]]; then
+    step "debian12: MeshLab 2020.09 on the host (tests/hosts/meshlab2020.sh)"
+    # Its checks go into $results; a status without a FAIL line there (it stopped early) is one.
+    nfail=$(grep -c '^FAIL' "$results" || true)
+    if ! VSTREE_HOSTS_RESULTS=$results JOBS=$JOBS bash tests/hosts/meshlab2020.sh; then
+        [ "$(grep -c '^FAIL' "$results" || true)" -gt "$nfail" ] ||
+            fail "debian12 meshlab 2020.09: tests/hosts/meshlab2020.sh failed (its output is above)"
     fi
 fi
 
