@@ -15,6 +15,7 @@ meshlab_scalar() {
     local ref=$1 syms bit literals
     syms=$(nm -D --defined-only "$ref" 2>/dev/null) || return 1
     if grep -q getMLVersion <<<"$syms"; then
+        # shellcheck disable=SC2016 # sed patterns meant literally
         bit=$(objdump -d --no-show-raw-insn "$ref" |
             sed -n '/getMLVersion.*>:$/,/ret/p' | sed -n 's/.*movb *\$0x\([01]\),0x20(%rdi).*/\1/p' | head -n 1)
         if [ -z "$bit" ]; then
