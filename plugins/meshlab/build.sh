@@ -8,6 +8,8 @@
 # No MeshLab source is kept in the repository; everything goes under target/meshlab/.
 #
 # usage: plugins/meshlab/build.sh <2022.2.post4|2025.7.post1>
+#        HEADERS_ONLY=1 plugins/meshlab/build.sh 2020.09   (Debian 12's desktop MeshLab: there is
+#        no pymeshlab wheel of it, only its headers; tests/hosts/meshlab2020.sh builds the plugin)
 # env:   ML_FETCH=pool (default: Debian pool path) | apt (apt-get source with a temporary deb-src)
 #        JOBS=2   SKIP_APT=1 (do not touch apt)   VSTREE_NO_BUILD=1 (reuse target/release)
 #        HEADERS_ONLY=1: steps 2-3 only (tests/hosts builds against desktop MeshLab's own library)
@@ -21,7 +23,21 @@ JOBS="${JOBS:-2}"
 ML_FETCH="${ML_FETCH:-pool}"
 DEBIAN_MIRROR="${DEBIAN_MIRROR:-http://deb.debian.org/debian}"
 
+VCGLIB_GLOB='*/src/vcglib/*'
 case "$VER" in
+2020.09)
+	DEB_SRC_VERSION="2020.09+dfsg1-2"
+	DEB_SUITE="bookworm"
+	ORIG="meshlab_2020.09+dfsg1.orig.tar.xz"
+	ORIG_SHA256="d6715352ff65caffdec0292858d4263eb0c3cbbf3b1e5c2e2bab218e3f234630"
+	ORIG_SIZE=11594932
+	ML_VERSION_FILE="2020.09"
+	VCGLIB_GLOB='*/vcglib/*' # beside src/ in 2020.09
+	if [ "${HEADERS_ONLY:-0}" != 1 ]; then
+		echo "$0: 2020.09 is headers only (HEADERS_ONLY=1): there is no pymeshlab wheel of it" >&2
+		exit 2
+	fi
+	;;
 2022.2.post4)
 	DEB_SRC_VERSION="2022.02+dfsg1-1"
 	DEB_SUITE="trixie"
@@ -47,7 +63,7 @@ case "$VER" in
 	NUMPY_SHA256="89cd468399cfd2504718f0ba50e410dca55a170b61a02ad92bb18c8a65186e93"
 	;;
 *)
-	echo "usage: $0 <2022.2.post4|2025.7.post1>" >&2
+	echo "usage: $0 <2022.2.post4|2025.7.post1>, or HEADERS_ONLY=1 $0 2020.09" >&2
 	exit 2
 	;;
 esac
@@ -107,7 +123,7 @@ if [ ! -f "$SRC/.unpacked-$ORIG_SHA256" ]; then
 	rm -rf "$SRC"
 	mkdir -p "$SRC"
 	tar -xJf "$DL/$ORIG" -C "$SRC" --strip-components=1 --wildcards \
-		'*/ML_VERSION' '*/src/common/*' '*/src/vcglib/*'
+		'*/ML_VERSION' '*/src/common/*' "$VCGLIB_GLOB"
 	touch "$SRC/.unpacked-$ORIG_SHA256"
 fi
 [ "$(tr -d '[:space:]' <"$SRC/ML_VERSION")" = "$ML_VERSION_FILE" ] || { echo "bad ML_VERSION in $SRC" >&2; exit 1; }

@@ -289,7 +289,6 @@ FilterVstreePlugin::FilterVstreePlugin()
 }
 
 QString FilterVstreePlugin::pluginName() const { return "FilterVstree"; }
-QString FilterVstreePlugin::vendor() const { return "vstree"; }
 
 QString FilterVstreePlugin::filterName(ActionIDType f) const
 {
@@ -298,16 +297,6 @@ QString FilterVstreePlugin::filterName(ActionIDType f) const
 	case FP_RECONSTRUCT: return "VS-Tree Surface Reconstruction";
 	case FP_COLOUR: return "VS-Tree Cluster Colouring";
 	default: return QString();
-	}
-}
-
-QString FilterVstreePlugin::pythonFilterName(ActionIDType f) const
-{
-	switch (f) {
-	case FP_SIMPLIFY: return "vstree_clustering_simplification";
-	case FP_RECONSTRUCT: return "vstree_surface_reconstruction";
-	case FP_COLOUR: return "vstree_cluster_colouring";
-	default: return FilterPlugin::pythonFilterName(f);
 	}
 }
 
@@ -330,37 +319,33 @@ QString FilterVstreePlugin::filterInfo(ActionIDType f) const
 	}
 }
 
-FilterPlugin::FilterClass FilterVstreePlugin::getClass(const QAction* a) const
+FilterPlugin::FilterClass FilterVstreePlugin::filterClass(ActionIDType f) const
 {
-	switch (ID(a)) {
+	switch (f) {
 	case FP_SIMPLIFY: return FilterPlugin::Remeshing;
 	case FP_RECONSTRUCT: return FilterClass(FilterPlugin::PointSet | FilterPlugin::Remeshing);
 	case FP_COLOUR: return FilterPlugin::VertexColoring;
+#if VSTREE_MESHLAB_2020
+	default: return FilterPlugin::Generic; // renamed Other in 2022.02
+#else
 	default: return FilterPlugin::Other;
+#endif
 	}
 }
 
-FilterPlugin::FilterArity FilterVstreePlugin::filterArity(const QAction*) const { return SINGLE_MESH; }
-
-int FilterVstreePlugin::getPreConditions(const QAction*) const
+int FilterVstreePlugin::postConditionOf(ActionIDType f) const
 {
-	// Point clouds are valid input for all three; vstree itself reports what is missing.
-	return MeshModel::MM_NONE;
-}
-
-int FilterVstreePlugin::postCondition(const QAction* a) const
-{
-	switch (ID(a)) {
+	switch (f) {
 	case FP_COLOUR: return MeshModel::MM_VERTCOLOR;
 	default: return MeshModel::MM_NONE; // new layer, source untouched
 	}
 }
 
-RichParameterList FilterVstreePlugin::initParameterList(const QAction* a, const MeshModel& m)
+RichParameterList FilterVstreePlugin::parameters(ActionIDType f, const MeshModel& m) const
 {
 	RichParameterList pl;
 	const double diagonal = double(m.cm.bbox.Diag());
-	switch (ID(a)) {
+	switch (f) {
 	case FP_SIMPLIFY:
 		addSizeParams(pl, vstree_simplify_params_default());
 		addTreeParams(pl, vstree_simplify_params_default(), diagonal);
@@ -392,12 +377,8 @@ RichParameterList FilterVstreePlugin::initParameterList(const QAction* a, const 
 	return pl;
 }
 
-std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
-	const QAction*           action,
-	const RichParameterList& par,
-	MeshDocument&            md,
-	unsigned int&            /*postConditionMask*/,
-	vcg::CallBackPos*        cb)
+std::map<std::string, QVariant> FilterVstreePlugin::apply(
+	ActionIDType filter, const RichParameterList& par, MeshDocument& md, vcg::CallBackPos* cb)
 {
 	std::map<std::string, QVariant> out;
 	MeshModel* src = md.mm();
@@ -409,7 +390,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 	// Only point clouds pass normals; all of them must be non-zero.
 	const bool passNormals = isCloud && a.zeroNormals == 0;
 
-	switch (ID(action)) {
+	switch (filter) {
 	case FP_SIMPLIFY: {
 		MeshHandle in;
 		makeInput(a, passNormals, in);
@@ -421,19 +402,19 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 		const vstree_simplify_stats* s = vstree_simplify_result_get_stats(res);
 		MeshModel* dst = md.addNewMesh("", src->label() + " (vstree)", true);
 		fromVstree(vstree_simplify_result_get_mesh(res), dst->cm);
-		log("VS-Tree simplification: %llu -> %llu vertices, %llu -> %llu triangles, %llu clusters "
+		logf("VS-Tree simplification: %llu -> %llu vertices, %llu -> %llu triangles, %llu clusters "
 			"(%llu V, %llu T, %llu S nodes), depth %u, %.3f s",
 			(unsigned long long)s->input_vertices, (unsigned long long)s->output_vertices,
 			(unsigned long long)s->input_triangles, (unsigned long long)s->output_triangles,
 			(unsigned long long)s->clusters, (unsigned long long)s->v_nodes,
 			(unsigned long long)s->t_nodes, (unsigned long long)s->s_nodes, s->max_depth,
 			s->seconds_total);
-		log("topology %s", s->kept_topology ? "kept" : "not kept (plain clustering)");
+		logf("topology %s", s->kept_topology ? "kept" : "not kept (plain clustering)");
 		if (s->target_faces > 0) {
 			const uint64_t slack = std::max<uint64_t>(2, s->target_faces / 100);
 			const uint64_t got = s->output_triangles, want = s->target_faces;
 			if ((got > want ? got - want : want - got) > slack)
-				log("%llu triangles instead of the %llu asked for: %s", (unsigned long long)got,
+				logf("%llu triangles instead of the %llu asked for: %s", (unsigned long long)got,
 					(unsigned long long)want,
 					got > want ? (s->kept_topology ? "fewer would change the topology; set 'Keep topology' to Off to allow it"
 												   : "no further edge collapses without folding the surface")
@@ -473,7 +454,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 		const vstree_reconstruct_stats* s = vstree_reconstruct_result_get_stats(res);
 		MeshModel* dst = md.addNewMesh("", src->label() + " (vstree reconstruction)", true);
 		fromVstree(vstree_reconstruct_result_get_mesh(res), dst->cm);
-		log("VS-Tree reconstruction: %llu points -> %llu vertices, %llu triangles; base mesh %llu "
+		logf("VS-Tree reconstruction: %llu points -> %llu vertices, %llu triangles; base mesh %llu "
 			"triangles (genus %d%s), %u levels (stopped: %s), RMS error %.3g of the diagonal, %llu "
 			"normals estimated, %.3f s",
 			(unsigned long long)a.vertIndex.size(), (unsigned long long)s->output_vertices,
@@ -519,7 +500,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 			v.C() = vcg::Color4b((h & 0xff) | 0x20, ((h >> 8) & 0xff) | 0x20, ((h >> 16) & 0xff) | 0x20, 255);
 		}
 		const vstree_tree_stats* s = vstree_tree_get_stats(tree);
-		log("VS-Tree colouring by %s: %llu clusters, %llu T-nodes, %llu unlabelled vertices, max "
+		logf("VS-Tree colouring by %s: %llu clusters, %llu T-nodes, %llu unlabelled vertices, max "
 			"cluster error %.3g",
 			kind == VSTREE_LABEL_KIND_T_NODE ? "T-node" : "cluster", (unsigned long long)s->clusters,
 			(unsigned long long)s->t_nodes, (unsigned long long)unlabelled, s->max_cluster_error);
@@ -528,11 +509,74 @@ std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
 		out["unlabelled"] = QVariant(int(unlabelled));
 		break;
 	}
-	default: wrongActionCalled(action);
+	default: throw MLException(QString("vstree: unknown filter %1").arg(filter));
 	}
 	if (cb != nullptr)
 		cb(100, "vstree: done");
 	return out;
 }
+
+// The overrides of the interface the plugin is built for (meshlab_compat.h).
+#if VSTREE_MESHLAB_2020
+FilterPlugin::FilterClass FilterVstreePlugin::getClass(QAction* a) { return filterClass(ID(a)); }
+FilterPlugin::FILTER_ARITY FilterVstreePlugin::filterArity(QAction*) const { return SINGLE_MESH; }
+// Point clouds are valid input for all three; vstree itself reports what is missing.
+int FilterVstreePlugin::getPreConditions(QAction*) const { return MeshModel::MM_NONE; }
+int FilterVstreePlugin::postCondition(QAction* a) const { return postConditionOf(ID(a)); }
+
+void FilterVstreePlugin::initParameterSet(QAction* a, MeshModel& m, RichParameterList& params)
+{
+	params = parameters(ID(a), m);
+}
+
+// 2020.09 has no error exceptions: the message goes to errorMessage (the GUI's error box) and
+// to the log, since meshlabserver prints only "Problem with filter" and the log; the outputs
+// go to the log too.
+bool FilterVstreePlugin::applyFilter(QAction* action, MeshDocument& md, const RichParameterList& par, vcg::CallBackPos* cb)
+{
+	try {
+		for (const auto& kv : apply(ID(action), par, md, cb))
+			logf("%s = %s", kv.first.c_str(), qUtf8Printable(kv.second.toString()));
+		return true;
+	} catch (const MLException& e) {
+		errorMessage = QString::fromLocal8Bit(e.what());
+		logf("%s", e.what());
+		return false;
+	}
+}
+#else
+QString FilterVstreePlugin::vendor() const { return "vstree"; }
+
+QString FilterVstreePlugin::pythonFilterName(ActionIDType f) const
+{
+	switch (f) {
+	case FP_SIMPLIFY: return "vstree_clustering_simplification";
+	case FP_RECONSTRUCT: return "vstree_surface_reconstruction";
+	case FP_COLOUR: return "vstree_cluster_colouring";
+	default: return FilterPlugin::pythonFilterName(f);
+	}
+}
+
+FilterPlugin::FilterClass FilterVstreePlugin::getClass(const QAction* a) const { return filterClass(ID(a)); }
+FilterPlugin::FilterArity FilterVstreePlugin::filterArity(const QAction*) const { return SINGLE_MESH; }
+// Point clouds are valid input for all three; vstree itself reports what is missing.
+int FilterVstreePlugin::getPreConditions(const QAction*) const { return MeshModel::MM_NONE; }
+int FilterVstreePlugin::postCondition(const QAction* a) const { return postConditionOf(ID(a)); }
+
+RichParameterList FilterVstreePlugin::initParameterList(const QAction* a, const MeshModel& m)
+{
+	return parameters(ID(a), m);
+}
+
+std::map<std::string, QVariant> FilterVstreePlugin::applyFilter(
+	const QAction*           action,
+	const RichParameterList& par,
+	MeshDocument&            md,
+	unsigned int&            /*postConditionMask*/,
+	vcg::CallBackPos*        cb)
+{
+	return apply(ID(action), par, md, cb);
+}
+#endif
 
 MESHLAB_PLUGIN_NAME_EXPORTER(FilterVstreePlugin)

@@ -1,9 +1,13 @@
 """PLY files for tests/hosts, standard library only (runs with the host's python3).
 
   ply.py torus OUT.ply [MAJOR MINOR]   writes a closed triangulated torus (genus 1)
-  ply.py stats IN.ply                  prints "vertices V faces F closed 0|1 euler X"
+  ply.py torus-points OUT.ply [MAJOR MINOR]  the same torus's vertices only (a point cloud)
+  ply.py obj2ply IN.obj OUT.ply       the OBJ's vertices and faces as binary PLY (MeshLab
+                                       2020.09's OBJ reader aborts on some files)
+  ply.py stats IN.ply|IN.obj           prints "vertices V faces F closed 0|1 euler X"
                                        (closed: every edge is on exactly two faces)
-Reads ascii and binary_little_endian PLY with any scalar vertex properties and a face list.
+Reads ascii and binary_little_endian PLY with any scalar vertex properties and a face list,
+and the v/f lines of OBJ.
 """
 
 import math
@@ -17,7 +21,7 @@ TYPES = {
 }
 
 
-def torus(path, major=96, minor=32, r1=1.0, r2=0.35):
+def torus(path, major=96, minor=32, r1=1.0, r2=0.35, with_faces=True):
     verts, faces = [], []
     for i in range(major):
         u = 2 * math.pi * i / major
@@ -31,6 +35,8 @@ def torus(path, major=96, minor=32, r1=1.0, r2=0.35):
             c = ((i + 1) % major) * minor + (j + 1) % minor
             d = i * minor + (j + 1) % minor
             faces += [(a, b, c), (a, c, d)]
+    if not with_faces:
+        faces = []
     with open(path, "w") as f:
         f.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
                 "element face %d\nproperty list uchar int vertex_indices\nend_header\n" % (len(verts), len(faces)))
@@ -38,7 +44,37 @@ def torus(path, major=96, minor=32, r1=1.0, r2=0.35):
         f.writelines("3 %d %d %d\n" % t for t in faces)
 
 
+def read_obj(path, positions=None):
+    nverts, faces = 0, []
+    with open(path, "rb") as f:
+        for line in f:
+            w = line.split()
+            if not w:
+                continue
+            if w[0] == b"v":
+                nverts += 1
+                if positions is not None:
+                    positions.append(tuple(float(t) for t in w[1:4]))
+            elif w[0] == b"f":  # 1-based, or negative (relative); v/vt/vn
+                idx = [int(t.split(b"/")[0]) for t in w[1:]]
+                faces.append([i - 1 if i > 0 else nverts + i for i in idx])
+    return nverts, faces
+
+
+def obj2ply(src, dst):
+    positions = []
+    _, faces = read_obj(src, positions)
+    with open(dst, "wb") as f:
+        f.write(b"ply\nformat binary_little_endian 1.0\nelement vertex %d\nproperty float x\nproperty float y\n"
+                b"property float z\nelement face %d\nproperty list uchar int vertex_indices\nend_header\n"
+                % (len(positions), len(faces)))
+        f.write(b"".join(struct.pack("<3f", *p) for p in positions))
+        f.write(b"".join(struct.pack("<B%di" % len(t), len(t), *t) for t in faces))
+
+
 def read(path):
+    if path.lower().endswith(".obj"):
+        return read_obj(path)
     with open(path, "rb") as f:
         data = f.read()
     end = data.index(b"end_header") + len(b"end_header")
@@ -110,6 +146,10 @@ def stats(path):
 if __name__ == "__main__":
     if sys.argv[1] == "torus":
         torus(sys.argv[2], *(int(a) for a in sys.argv[3:5]))
+    elif sys.argv[1] == "torus-points":
+        torus(sys.argv[2], *(int(a) for a in sys.argv[3:5]), with_faces=False)
+    elif sys.argv[1] == "obj2ply":
+        obj2ply(sys.argv[2], sys.argv[3])
     elif sys.argv[1] == "stats":
         stats(sys.argv[2])
     else:

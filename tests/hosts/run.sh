@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # The plugins in the desktop applications users open, under Xvfb with Mesa's software OpenGL.
 #   debian13: Blender 4.3.2 and MeshLab 2022.02, the packages of Debian 13 (trixie), pinned.
+#   debian12: MeshLab 2020.09, Debian 12's package, on the host itself when it is Debian 12
+#             (tests/hosts/meshlab2020.sh: the plugin built for 2020.09's interface,
+#             meshlabserver applies both filters from .mlx scripts; skipped on other hosts).
 #   sid:      Blender and MeshLab of Debian unstable, not pinned (the versions are printed); a
 #             chroot that cannot be built (mirror churn) is reported as skipped with the reason.
 # Each system is a chroot made with mmdebstrap from Debian's mirror and kept outside the clone,
@@ -18,7 +21,7 @@
 # Installs what it needs on the host (Debian 12 or later, as root). Each check prints ok/FAIL;
 # the last line is "N passed, M failed" and the status is non-zero when anything failed.
 # env: DEBIAN_MIRROR (default http://deb.debian.org/debian), JOBS=2,
-#      VSTREE_HOSTS_SYSTEMS="debian13 sid" (the default: both),
+#      VSTREE_HOSTS_SYSTEMS="debian13 sid debian12" (the default: all three),
 #      VSTREE_HOSTS_APPS="blender meshlab" (the default: both),
 #      VSTREE_HOSTS_SCREENSHOTS=1 copies Debian 13's screenshots into docs/images/ (they always
 #      go to target/hosts/shots/).
@@ -32,7 +35,7 @@ mirror=${DEBIAN_MIRROR:-http://deb.debian.org/debian}
 cache=${XDG_CACHE_HOME:-$HOME/.cache}/vstree/chroots
 work=$root/target/hosts
 data=$(cd "$root/.." && pwd)/shared/data
-systems=" ${VSTREE_HOSTS_SYSTEMS:-debian13 sid} "
+systems=" ${VSTREE_HOSTS_SYSTEMS:-debian13 sid debian12} "
 apps=" ${VSTREE_HOSTS_APPS:-blender meshlab} "
 
 # Debian 13 packages under test, pinned.
@@ -47,6 +50,8 @@ D13_RUN="python3-numpy chemical-mime-data lib3ds-1-3 libmpfr6 libmuparser2v5 lib
 BUILD_DEPS="g++ make cmake qtbase5-dev libqt5opengl5-dev libglew-dev libeigen3-dev"
 
 step() { echo "== [$((SECONDS - T0)) s] $*"; }
+# shellcheck source=tests/hosts/meshlab_scalar.sh
+source tests/hosts/meshlab_scalar.sh
 
 if [ "$(id -u)" -ne 0 ]; then
     echo "tests/hosts/run.sh: needs root (mmdebstrap, chroot, mounts)" >&2
@@ -353,33 +358,12 @@ test_meshlab() {
     cp "$libvstree" "$prefix/lib/libvstree.so.0"
     ln -sf libvstree.so.0 "$prefix/lib/libvstree.so"
     cp include/vstree.h "$prefix/include/"
-    # The scalar type MeshLab was built with, read from one of its own plugins: getMLVersion()
-    # returns (version, builtWithDoublePrecision()), the latter comparing the string of
-    # MESHLAB_SCALAR with "double". 2022.02's compiler folds it to a constant stored in the
-    # returned pair (offset 0x20); 2025.07's keeps the comparison, with the literals "float"
-    # and "double" (one "double" only when MESHLAB_SCALAR is double). Debian's 2022.02 is
-    # float, pymeshlab's wheels double; a plugin of the other type is refused at load time.
-    local ref=$c$ml_lib/plugins/libfilter_clean.so
-    scalar=$(objdump -d --no-show-raw-insn "$ref" |
-        sed -n '/getMLVersion.*>:$/,/ret/p' | sed -n 's/.*movb *\$0x\([01]\),0x20(%rdi).*/\1/p' | head -n 1)
-    if [ -z "$scalar" ]; then
-        # (not `strings | grep -q`: grep's early exit can fail the pipe under pipefail)
-        local literals
-        literals=$(strings -n 5 "$ref")
-        if grep -qx float <<<"$literals"; then
-            scalar=0
-        elif grep -qx double <<<"$literals"; then
-            scalar=1
-        fi
+    # The scalar type MeshLab was built with, read from one of its own plugins
+    # (tests/hosts/meshlab_scalar.sh).
+    if ! scalar=$(meshlab_scalar "$c$ml_lib/plugins/libfilter_clean.so"); then
+        fail "$sys meshlab: cannot tell whether MeshLab $ml_version is built with float or double"
+        return 0
     fi
-    case $scalar in
-        0) scalar=float ;;
-        1) scalar=double ;;
-        *)
-            fail "$sys meshlab: cannot tell whether MeshLab $ml_version is built with float or double"
-            return 0
-            ;;
-    esac
     echo "MeshLab $ml_version: built with $scalar scalars"
     in_chroot cmake -S /vstree/plugins/meshlab -B "/vstree/target/hosts/$sys/meshlab-build" \
         -DCMAKE_BUILD_TYPE=Release -DMESHLAB_SRC_DIR="/vstree/$ml_src" -DMESHLAB_LIB_DIR="$ml_lib" \
@@ -561,6 +545,16 @@ if [[ $systems == *" sid "* ]]; then
                 *) fail "$sys meshlab: $(chroot "$c" dpkg-query -W -f='${Version}' meshlab) has no headers recipe in plugins/meshlab/build.sh" ;;
             esac
         fi
+    fi
+fi
+
+if [[ $systems == *" debian12 "* ]] && [[ $apps == *" meshlab "* ]]; then
+    step "debian12: MeshLab 2020.09 on the host (tests/hosts/meshlab2020.sh)"
+    # Its checks go into $results; a status without a FAIL line there (it stopped early) is one.
+    nfail=$(grep -c '^FAIL' "$results" || true)
+    if ! VSTREE_HOSTS_RESULTS=$results JOBS=$JOBS bash tests/hosts/meshlab2020.sh; then
+        [ "$(grep -c '^FAIL' "$results" || true)" -gt "$nfail" ] ||
+            fail "debian12 meshlab 2020.09: tests/hosts/meshlab2020.sh failed (its output is above)"
     fi
 fi
 
