@@ -25,3 +25,16 @@ for v in $versions; do
 	VSTREE_MESHLAB_PLUGIN="$unpacked/libfilter_vstree.so" \
 		"target/meshlab/$v/venv/bin/python" tests/meshlab/test_vstree_meshlab.py
 done
+# Bad plugins: each host is given the other version's plugin, and its own without the library.
+for v in $versions; do
+	for other in $versions; do
+		[ "$other" = "$v" ] && continue
+		echo "== MeshLab plugin: pymeshlab $v: the $other plugin, and a plugin without libvstree"
+		lone="target/meshlab/$v/lone"
+		rm -rf "$lone"
+		mkdir -p "$lone"
+		cp "target/meshlab/$v/unpacked/libfilter_vstree.so" "$lone/"
+		"target/meshlab/$v/venv/bin/python" tests/meshlab/test_load_failures.py \
+			"target/meshlab/$other/unpacked/libfilter_vstree.so" "$lone/libfilter_vstree.so"
+	done
+done
