@@ -138,3 +138,21 @@ def test_zip_for_another_platform_is_refused(addon, zip_path, capfd):
     finally:
         bpy.ops.preferences.extension_repo_remove(index=len(repos) - 1)
         shutil.rmtree(directory, ignore_errors=True)
+
+
+def test_missing_numpy_says_what_to_install(scene, addon):
+    """A Blender on a system Python without numpy (Debian's): enabling worked, and the
+    operators say to install numpy instead of failing on an import."""
+    core = addon.core
+    numpy = core.np
+    core.np = None
+    try:
+        with Unloaded(core):
+            bpy.ops.mesh.primitive_uv_sphere_add()
+            with pytest.raises(RuntimeError, match=r"needs numpy.*apt install python3-numpy"):
+                bpy.ops.vstree.simplify()
+            assert len(bpy.data.objects) == 1
+            assert not core.status()[0] and "python3-numpy" in core.status()[1]
+    finally:
+        core.np = numpy
+    assert core.status()[0]

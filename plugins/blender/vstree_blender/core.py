@@ -11,7 +11,10 @@ import os
 import platform
 
 import bpy
-import numpy as np
+try:
+    import numpy as np
+except ImportError:  # Blender built on the system's Python (Debian's) may come without numpy
+    np = None
 
 _BINDING = None
 _BINDING_ERROR = None
@@ -26,6 +29,11 @@ def binding():
     :class:`VstreeUnavailable` with a readable message when the library cannot be loaded; the
     failure is not cached, so fixing the installation and retrying works."""
     global _BINDING, _BINDING_ERROR
+    if np is None:
+        raise VstreeUnavailable(
+            "VS-Tree needs numpy, which this Blender's Python does not have: install it "
+            "(Debian and Ubuntu: apt install python3-numpy) and restart Blender"
+        )
     if _BINDING is None:
         try:
             _BINDING = importlib.import_module(__package__ + ".vstree")
