@@ -102,19 +102,9 @@ pub(crate) struct BaseMesh {
 impl BaseMesh {
     /// Removes the vertices no triangle uses, with their labels.
     pub fn drop_unused_vertices(&mut self) {
-        let mut index = vec![u32::MAX; self.mesh.positions.len()];
-        let (mut positions, mut labels) = (Vec::new(), Vec::new());
-        for t in self.mesh.triangles.iter_mut() {
-            for v in t.iter_mut() {
-                if index[*v as usize] == u32::MAX {
-                    index[*v as usize] = positions.len() as u32;
-                    positions.push(self.mesh.positions[*v as usize]);
-                    labels.push(self.labels[*v as usize]);
-                }
-                *v = index[*v as usize];
-            }
-        }
-        (self.mesh.positions, self.labels) = (positions, labels);
+        let kept = super::renumber_used_vertices(&mut self.mesh.triangles, self.mesh.positions.len());
+        self.mesh.positions = kept.iter().map(|&v| self.mesh.positions[v]).collect();
+        self.labels = kept.iter().map(|&v| self.labels[v]).collect();
     }
 }
 

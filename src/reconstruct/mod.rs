@@ -723,6 +723,21 @@ fn sample_error(s: &mut refine::Surface, points: &[Vec3], diagonal: f32, threads
     ((sum_sq / points.len().max(1) as f64).sqrt() / d, max / d)
 }
 
+/// Renumbers the vertices that `triangles` use 0, 1, ... in the order they first appear, and
+/// returns the old index of each new one (vertices no triangle uses are left out).
+pub(super) fn renumber_used_vertices(triangles: &mut [[u32; 3]], vertices: usize) -> Vec<usize> {
+    let mut index = vec![u32::MAX; vertices];
+    let mut kept = Vec::new();
+    for v in triangles.iter_mut().flatten() {
+        if index[*v as usize] == u32::MAX {
+            index[*v as usize] = kept.len() as u32;
+            kept.push(*v as usize);
+        }
+        *v = index[*v as usize];
+    }
+    kept
+}
+
 /// Removes the faces whose centre is farther than `distance` from every sample (`anywhere`),
 /// or only those of the connected sets of such faces that reach the mesh's border; then the
 /// vertices no face uses. Returns how many faces went.
@@ -745,23 +760,9 @@ fn trim_far_faces(mesh: &mut Mesh, samples: &PointBvh, distance: f32, anywhere: 
     let before = mesh.triangles.len();
     let mut k = keep.iter();
     mesh.triangles.retain(|_| *k.next().unwrap_or(&true));
-    let mut index = vec![u32::MAX; mesh.positions.len()];
-    let mut positions = Vec::new();
-    let mut normals = Vec::new();
-    for t in mesh.triangles.iter_mut() {
-        for v in t.iter_mut() {
-            if index[*v as usize] == u32::MAX {
-                index[*v as usize] = positions.len() as u32;
-                positions.push(mesh.positions[*v as usize]);
-                if let Some(n) = &mesh.normals {
-                    normals.push(n[*v as usize]);
-                }
-            }
-            *v = index[*v as usize];
-        }
-    }
-    mesh.normals = mesh.normals.as_ref().map(|_| normals);
-    mesh.positions = positions;
+    let kept = renumber_used_vertices(&mut mesh.triangles, mesh.positions.len());
+    mesh.positions = kept.iter().map(|&v| mesh.positions[v]).collect();
+    mesh.normals = mesh.normals.as_ref().map(|n| kept.iter().map(|&v| n[v]).collect());
     before - mesh.triangles.len()
 }
 
