@@ -105,8 +105,9 @@ pub struct vstree_simplify_params {
     /// Triangles wanted, from 1 to the input's count; 0 (the default) = as many as `error`
     /// gives. With a target, `error` is no bound: the tree is grown or cut, splitting the
     /// cluster with the largest error first, to about half as many clusters as triangles
-    /// wanted, and quadric edge collapses (under the same topology rules) bring the mesh to
-    /// the target, within one triangle. A target below what the topology allows (a closed
+    /// wanted (twice as many when the topology is kept, so that collapses choose the last
+    /// vertices), and quadric edge collapses (under the same topology rules) bring the mesh
+    /// to the target, within one triangle. A target below what the topology allows (a closed
     /// surface of genus g needs more than 4 g triangles; a tetrahedron, 4, is the least) gives
     /// the smallest mesh the collapses reach: compare the stats' `output_triangles`. Meshes
     /// only; ignored by vstree_tree_build(). Since 0.2.0.
