@@ -70,7 +70,7 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 2
+#define VSTREE_VERSION_MINOR 3
 
 /**
  * Patch version (semver).
@@ -121,8 +121,9 @@
 #define VSTREE_BASE_MESH_PAPER 1
 
 /**
- * `closure` value: open when more than 15% of the closed surface is far from every point.
- * Experimental: some noisy or sparse closed clouds come out open.
+ * `closure` value: open when more than 30% of the closed surface is unsupported by the points
+ * (far from all, or near only points facing the other way; a scan from one side leaves about
+ * half), else closed. The default since 0.3.0.
  */
 #define VSTREE_CLOSURE_AUTO 0
 
@@ -482,8 +483,9 @@ typedef struct vstree_simplify_params {
    * Triangles wanted, from 1 to the input's count; 0 (the default) = as many as `error`
    * gives. With a target, `error` is no bound: the tree is grown or cut, splitting the
    * cluster with the largest error first, to about half as many clusters as triangles
-   * wanted, and quadric edge collapses (under the same topology rules) bring the mesh to
-   * the target, within one triangle. A target below what the topology allows (a closed
+   * wanted (twice as many when the topology is kept, so that collapses choose the last
+   * vertices), and quadric edge collapses (under the same topology rules) bring the mesh
+   * to the target, within one triangle. A target below what the topology allows (a closed
    * surface of genus g needs more than 4 g triangles; a tetrahedron, 4, is the least) gives
    * the smallest mesh the collapses reach: compare the stats' `output_triangles`. Meshes
    * only; ignored by vstree_tree_build(). Since 0.2.0.
@@ -986,9 +988,9 @@ typedef struct vstree_reconstruct_params {
    */
   uint32_t threads;
   /**
-   * Open or closed output, a VSTREE_CLOSURE_* value. Default VSTREE_CLOSURE_CLOSED; use
-   * VSTREE_CLOSURE_OPEN for a scan from one side (only the part of the surface the points
-   * support is kept). Since 0.2.0.
+   * Open or closed output, a VSTREE_CLOSURE_* value. Default VSTREE_CLOSURE_AUTO (since
+   * 0.3.0; VSTREE_CLOSURE_CLOSED before): a scan from one side comes out open, a closed
+   * object closed. Since 0.2.0.
    */
   int32_t closure;
   /**
@@ -1131,8 +1133,8 @@ typedef struct vstree_reconstruct_stats {
    */
   uint32_t base_boundary_edges;
   /**
-   * Share of the closed polygonised surface's area far from every point (about half for a
-   * scan from one side); `closure` AUTO makes the output open above 0.15. Since 0.2.0.
+   * Share of the closed polygonised surface's area unsupported by the points (far from all,
+   * or near only points facing the other way; about half for a scan from one side); `closure` AUTO makes the output open above 0.3. Since 0.2.0.
    */
   double unsupported_share;
 } vstree_reconstruct_stats;
@@ -1515,8 +1517,8 @@ struct vstree_reconstruct_params vstree_reconstruct_params_default(void);
 /**
  * Reconstructs a triangle mesh from the points of `cloud` (its triangles, if any, are
  * ignored): normals are estimated where the cloud has none (all, or zero-length ones), the
- * VS-Tree of the points is built, its T-nodes give a coarse base mesh (closed, or with
- * `params->closure` VSTREE_CLOSURE_OPEN only the part the points support), which is refined
+ * VS-Tree of the points is built, its T-nodes give a coarse base mesh (closed, or only the
+ * part the points support where `params->closure` says so), which is refined
  * by the quadtrees below them until it is close enough to the points; with `params->trim` >
  * 0, faces far from every point are removed at the end. The output has
  * unit per-vertex normals and counter-clockwise triangles seen from outside.

@@ -213,8 +213,9 @@ fn an_interrupted_run_leaves_no_temporary_file() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// A surface that does not follow the cloud (here the closed blob made of an open hemisphere)
-/// is not passed off as a result: the run says so on stderr.
+/// A surface that does not follow the cloud (here the closed blob that the paper's base mesh,
+/// asked to close, makes of an open hemisphere) is not passed off as a result: the run says so
+/// on stderr.
 #[test]
 fn a_surface_far_from_its_samples_is_reported() {
     let dir = temp_dir("far-surface");
@@ -224,7 +225,9 @@ fn a_surface_far_from_its_samples_is_reported() {
         cloud.positions.iter().zip(&normals).filter(|(p, _)| p.z >= 0.0).unzip();
     let input = dir.join("hemisphere.ply");
     io::write(&input, &vstree::Mesh::from_points(positions, Some(normals))).unwrap();
-    let run = vstree(&["reconstruct", input.to_str().unwrap(), dir.join("out.ply").to_str().unwrap()]);
+    let output = dir.join("out.ply");
+    let run =
+        vstree(&["reconstruct", input.to_str().unwrap(), output.to_str().unwrap(), "--closed", "--base-mesh", "paper"]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(run.status.success(), "{stderr}");
     assert!(stderr.contains("warning: the surface is far from the samples (RMS "), "{stderr}");

@@ -33,6 +33,21 @@ fn folded_share(mesh: &Mesh) -> f64 {
     folded as f64 / mesh.triangles.len().max(1) as f64
 }
 
+/// Shares of triangles whose smallest angle is under 10 and under 20 degrees.
+fn thin_shares(mesh: &Mesh) -> (f64, f64) {
+    let smallest: Vec<f32> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            let at = |p: Vec3, q: Vec3, r: Vec3| (q - p).angle_between(r - p).to_degrees();
+            at(a, b, c).min(at(b, c, a)).min(at(c, a, b))
+        })
+        .collect();
+    let share = |deg: f32| smallest.iter().filter(|&&x| x < deg).count() as f64 / smallest.len().max(1) as f64;
+    (share(10.0), share(20.0))
+}
+
 /// The checks every closed input must pass: M0 and the result watertight with `genus`, mostly
 /// valence 6, and close to the samples both ways.
 fn assert_closed_reconstruction(name: &str, cloud: &Mesh, genus: u32) {
@@ -40,14 +55,17 @@ fn assert_closed_reconstruction(name: &str, cloud: &Mesh, genus: u32) {
     let report = topology::analyze(&mesh);
     let diagonal = cloud.bounds().unwrap().diagonal();
     let (chamfer, hausdorff) = chamfer_and_hausdorff(&mesh, cloud, 100_000, 1);
+    let thin = thin_shares(&mesh);
     eprintln!(
-        "{name}: M0 {} vertices genus {:?}; {} levels; {} triangles; valence 6: {:.1}%; folded {:.2}%; error {:.2e}; chamfer {:.2e}, hausdorff {:.2e} (x diagonal)",
+        "{name}: M0 {} vertices genus {:?}; {} levels; {} triangles; valence 6: {:.1}%; folded {:.2}%; under 10 and 20 degrees {:.2}% {:.2}%; error {:.2e}; chamfer {:.2e}, hausdorff {:.2e} (x diagonal)",
         stats.base_vertices,
         stats.base_genus,
         stats.levels.len(),
         mesh.triangles.len(),
         100.0 * regular_share(&mesh),
         100.0 * folded_share(&mesh),
+        100.0 * thin.0,
+        100.0 * thin.1,
         stats.final_error,
         chamfer / diagonal,
         hausdorff / diagonal
@@ -55,8 +73,12 @@ fn assert_closed_reconstruction(name: &str, cloud: &Mesh, genus: u32) {
     assert_eq!(stats.base_genus, Some(genus), "{name}: M0's genus");
     assert!(report.is_watertight(), "{name}: {report:?}");
     assert_eq!(report.genus(), Some(genus), "{name}: the result's genus");
-    // Measured at most 0.23% (fertility); 3-5% before M0 and each level were unfolded.
-    assert!(folded_share(&mesh) < 0.005, "{name}: {:.2}% folded triangles", 100.0 * folded_share(&mesh));
+    // Measured 0 on every one; at most 0.23% (fertility) before each level was unfolded
+    // onto the samples' fit.
+    assert!(folded_share(&mesh) < 1e-4, "{name}: {:.3}% folded triangles", 100.0 * folded_share(&mesh));
+    // Remeshing-grade triangles (issue 13's targets): measured at most 0.32% under 10 degrees
+    // and 1.73% under 20 (fertility).
+    assert!(thin.0 < 0.01 && thin.1 < 0.05, "{name}: {thin:?} under 10 and 20 degrees");
     assert!(regular_share(&mesh) > 0.9, "{name}: {:.1}% valence 6", 100.0 * regular_share(&mesh));
     // Distances as multiples of the threshold's own length: the tree's L2 bound e keeps every
     // sample's tangent plane within √e × diagonal of its cluster's point (3.2e-3 at 1e-5).
@@ -89,13 +111,40 @@ fn the_winding_base_mesh_keeps_a_thin_ring_that_the_planes_flatten() {
     let truth = shapes::torus(1.0, 0.03, 256, 32);
     let cloud = shapes::sample_surface(&truth, 60_000, 1);
     let mut chamfers = Vec::new();
+    // Closed asked for: the flattened ring's faces face away from its samples, which `Auto`
+    // would take for the back of an open scan.
     for base_mesh in [BaseMesh::Winding, BaseMesh::Paper] {
-        let (mesh, stats) = run(&cloud, &ReconstructParams { base_mesh, ..Default::default() });
+        let params = ReconstructParams { base_mesh, closure: Closure::Closed, ..Default::default() };
+        let (mesh, stats) = run(&cloud, &params);
         assert_eq!(stats.base_genus, Some(1), "{base_mesh:?}: M0's genus");
         assert_eq!(topology::analyze(&mesh).genus(), Some(1), "{base_mesh:?}: the result's genus");
         chamfers.push(chamfer_and_hausdorff(&mesh, &truth, 100_000, 1).0);
     }
     assert!(chamfers[0] < 0.8 * chamfers[1], "Chamfer: winding {:.3e}, paper {:.3e}", chamfers[0], chamfers[1]);
+}
+
+#[test]
+fn a_plate_thinner_than_the_grid_keeps_its_four_holes() {
+    // A 2 x 2 plate 0.024 thick with four holes 0.4 across: the grid (64 cells across the
+    // root cube, as coarse as the flat plate's large T-nodes allow) is wider than the plate,
+    // so its points see one side only and perforate it; thickened by THICKEN_CELLS, the plate
+    // is whole and its real holes, wider than twice the offset, stay open.
+    let half_thickness = 0.012;
+    let plate = |p: Vec3| {
+        let slab = (p.x.abs() - 1.0).max(p.y.abs() - 1.0).max(p.z.abs() - half_thickness);
+        let hole = [(0.5, 0.5), (-0.5, 0.5), (0.5, -0.5), (-0.5, -0.5)]
+            .iter()
+            .map(|&(x, y)| ((p.x - x).powi(2) + (p.y - y).powi(2)).sqrt() - 0.2)
+            .fold(f32::MAX, f32::min);
+        slab.max(-hole)
+    };
+    let truth = shapes::implicit_mesh(plate, Vec3::splat(-1.2), Vec3::splat(1.2), 300);
+    assert_eq!(topology::analyze(&truth).genus(), Some(4));
+    let cloud = shapes::sample_surface(&truth, 100_000, 1);
+    let (mesh, stats) = run(&cloud, &ReconstructParams::default());
+    let report = topology::analyze(&mesh);
+    assert!(stats.thickened, "the plate was not thickened (grid {} cells)", stats.grid_cells);
+    assert!(report.is_watertight() && report.components == 1 && report.genus() == Some(4), "{report:?}");
 }
 
 #[test]
@@ -234,8 +283,8 @@ fn same_mesh_with_one_or_two_threads() {
 #[test]
 fn a_single_range_scan_gives_an_open_mesh() {
     let Some(scan) = common::load("bunny_raw_bun000.ply") else { return };
-    // Found to be open, and made open.
-    let (mesh, stats) = run(&scan, &ReconstructParams { closure: Closure::Auto, ..Default::default() });
+    // Found to be open, and made open, by default.
+    let (mesh, stats) = run(&scan, &ReconstructParams::default());
     let report = topology::analyze(&mesh);
     eprintln!(
         "bun000: {:.0}% of the closed surface unsupported; {} triangles, {} boundary edges",
@@ -251,8 +300,8 @@ fn a_single_range_scan_gives_an_open_mesh() {
     // What is left is near the samples.
     let far = vstree::distance::one_sided(&mesh.positions, vstree::distance::Target::Points(&scan.positions));
     assert!(far.p99 < 0.01 * scan.bounds().unwrap().diagonal(), "p99 {}", far.p99);
-    // By default, the same scan gives a closed surface.
-    let (mesh, stats) = run(&scan, &ReconstructParams::default());
+    // Asked for, the same scan gives a closed surface.
+    let (mesh, stats) = run(&scan, &ReconstructParams { closure: Closure::Closed, ..Default::default() });
     assert!(!stats.open && topology::analyze(&mesh).is_watertight());
 }
 
@@ -264,6 +313,13 @@ fn sphere_points(count: usize, keep: impl Fn(Vec3) -> bool) -> Mesh {
     let cloud = shapes::sample_surface(&Mesh::new(sphere.positions.clone(), None, kept), count, 11);
     let on_sphere: Vec<Vec3> = cloud.positions.iter().map(|p| p.normalize()).collect();
     Mesh::from_points(on_sphere.clone(), Some(on_sphere))
+}
+
+/// The upper half of the unit icosphere that [`sphere_points`] samples for a hemisphere.
+fn hemisphere_mesh() -> Mesh {
+    let sphere = shapes::icosphere(1.0, 5);
+    let kept = sphere.triangles.iter().copied().filter(|t| t.iter().all(|&v| sphere.positions[v as usize].z > -1e-6));
+    Mesh::new(sphere.positions.clone(), None, kept.collect())
 }
 
 /// The median distance from a point to its nearest other point.
@@ -281,7 +337,7 @@ fn spacing(points: &[Vec3]) -> f32 {
 fn a_hemisphere_gives_an_open_dome_up_to_its_rim() {
     for count in [10_000, 100_000] {
         let cloud = sphere_points(count, |p| p.z > -1e-6);
-        let (mesh, stats) = run(&cloud, &ReconstructParams { closure: Closure::Auto, ..Default::default() });
+        let (mesh, stats) = run(&cloud, &ReconstructParams::default());
         let report = topology::analyze(&mesh);
         assert!(stats.open, "{count}: {:.2} unsupported", stats.unsupported_share);
         assert!(report.boundary_edges > 0 && report.non_manifold_edges == 0 && report.components == 1, "{report:?}");
@@ -291,17 +347,22 @@ fn a_hemisphere_gives_an_open_dome_up_to_its_rim() {
         let off = mesh.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max);
         assert!(off < 0.07, "{count}: a vertex {off} off the sphere");
         assert!(stats.final_error < 1e-3, "{count}: RMS {}", stats.final_error);
+        // Close to the true dome both ways (measured 7.7e-4 and 1.1e-3: the border's overshoot
+        // below the rim, see below, is most of it).
+        let dome = hemisphere_mesh();
+        let (chamfer, _) = chamfer_and_hausdorff(&mesh, &dome, 100_000, 1);
+        assert!(chamfer < 1.5e-3, "{count}: Chamfer {chamfer:.2e} to the dome");
         let h = spacing(&cloud.positions);
         let border_heights: Vec<f32> = border_vertices(&mesh).iter().map(|&v| mesh.positions[v].z).collect();
         let highest = border_heights.iter().copied().fold(f32::MIN, f32::max);
         let lowest = border_heights.iter().copied().fold(f32::MAX, f32::min);
-        // Measured: from -1.7 to +3.2 spacings at 10k points (the border overshoots by up to a
-        // grid cell, and is trimmed back as much where the refined surface strays).
-        // Below the rim the overshoot is up to about a grid cell (the grid spans the cloud's
-        // width of 2 in `grid_cells` cells; at 100k points it is 8 spacings).
+        // Measured: from -6.5 to +0.7 spacings at 10k points (the border overshoots below the
+        // rim by up to 2.5 grid cells where the closing sheet turns away, and is trimmed back
+        // where the refined surface strays; the grid spans the cloud's width of 2 in
+        // `grid_cells` cells; at 100k points a cell is 8 spacings).
         let cell = 2.0 / stats.grid_cells as f32;
         assert!(
-            highest < 3.5 * h && lowest > -(2.0 * cell).max(4.0 * h),
+            highest < 3.5 * h && lowest > -(3.0 * cell).max(4.0 * h),
             "{count}: border from z = {lowest} to {highest}, spacing {h}, cell {cell}"
         );
     }
@@ -327,13 +388,10 @@ fn border_vertices(mesh: &Mesh) -> Vec<usize> {
 
 #[test]
 fn a_sphere_with_a_small_hole_stays_closed_unless_asked() {
-    // A cap of 5% of the area unsampled: closed over by default and by `Auto`, kept open with
-    // `Open`.
+    // A cap of 5% of the area unsampled: closed over by default, kept open with `Open`.
     let cloud = sphere_points(40_000, |p| p.z < 0.9);
-    let auto = run(&cloud, &ReconstructParams { closure: Closure::Auto, ..Default::default() }).1;
-    assert!(!auto.open, "{:.3} unsupported", auto.unsupported_share);
     let (mesh, stats) = run(&cloud, &ReconstructParams::default());
-    assert!(!stats.open);
+    assert!(!stats.open, "{:.3} unsupported", stats.unsupported_share);
     let report = topology::analyze(&mesh);
     assert!(report.is_watertight() && report.genus() == Some(0), "{report:?}");
     let (mesh, stats) = run(&cloud, &ReconstructParams { closure: Closure::Open, ..Default::default() });
@@ -343,9 +401,9 @@ fn a_sphere_with_a_small_hole_stays_closed_unless_asked() {
     // open above z = 0.986 where the samples stop at 0.9.
     let top = mesh.positions.iter().map(|p| p.z).fold(f32::MIN, f32::max);
     assert!(top < 0.99, "the hole was covered up to z = {top}");
-    // A hemisphere is closed by default.
+    // A hemisphere is closed when asked.
     let dome = sphere_points(10_000, |p| p.z > -1e-6);
-    let (mesh, stats) = run(&dome, &ReconstructParams::default());
+    let (mesh, stats) = run(&dome, &ReconstructParams { closure: Closure::Closed, ..Default::default() });
     assert!(!stats.open && topology::analyze(&mesh).is_watertight());
 }
 

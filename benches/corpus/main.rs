@@ -30,7 +30,7 @@ use report::{Context, PeerRow, Report, Row};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use vstree::normals::{ensure_normals, NormalParams};
-use vstree::reconstruct::{Closure, ReconstructParams};
+use vstree::reconstruct::ReconstructParams;
 use vstree::{io, Mesh, Progress};
 
 const USAGE: &str = "\
@@ -394,8 +394,8 @@ impl Bench<'_> {
             self.start.elapsed().as_secs_f64()
         );
         let open = case.truth.open;
-        let closure = if open { Closure::Open } else { Closure::Closed };
-        let params = ReconstructParams { closure, threads: self.o.threads, ..ReconstructParams::default() };
+        // Defaults on every input: open or closed is found, not told.
+        let params = ReconstructParams { threads: self.o.threads, ..ReconstructParams::default() };
         let local_cloud = inputs::local(&case.cloud, case.offset);
         let samples = open.then(|| Samples::new(&local_cloud.positions));
         let stem = case.stem();

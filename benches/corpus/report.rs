@@ -184,7 +184,7 @@ impl Report {
         };
         let _ = writeln!(
             md,
-            "- vstree: `ReconstructParams::default()`, with `closure` Open on open inputs; threads: \
+            "- vstree: `ReconstructParams::default()` on every input (open or closed is found, not told); threads: \
              {threads}; {} timed run{} per input.{peers}",
             c.runs,
             if c.runs == 1 { "" } else { "s" }

@@ -31,6 +31,10 @@ const QStringList kMetrics{"L2 (quadric)", "L2,1 (normal deviation)", "Density (
 const QStringList kSamplings{"Vertices", "Face centers"};
 const QStringList kKeepTopology{"Auto (closed manifolds)", "On", "Off"};
 const QStringList kLabelKinds{"Cluster", "T-node"};
+// Indexed by the VSTREE_CLOSURE_* values.
+const QStringList kClosures{"Auto (open scans stay open)", "Closed", "Open"};
+static_assert(VSTREE_CLOSURE_AUTO == 0 && VSTREE_CLOSURE_CLOSED == 1 && VSTREE_CLOSURE_OPEN == 2,
+	"kClosures is indexed by the VSTREE_CLOSURE_* values");
 
 // A vstree status other than OK becomes an MLException carrying the C API's own message;
 // pymeshlab turns it into pymeshlab.PyMeshLabException.
@@ -364,9 +368,13 @@ RichParameterList FilterVstreePlugin::parameters(ActionIDType f, const MeshModel
 		addDistanceParam(pl, diagonal);
 		pl.addParam(RichInt("levels", int(d.max_levels), "Refinement levels",
 			"Most refinement levels, each multiplying the triangle count by 4; in [0, 12]."));
+		pl.addParam(RichEnum("surface", d.closure, kClosures, "Surface",
+			"Auto: open where the points cover one side only (a scan from one view: the output's "
+			"border follows the scan's), closed otherwise. Closed: holes and the back of a scan are "
+			"closed over. Open: only the part the points support, holes kept."));
 		pl.addParam(RichFloat("trim", Scalarm(d.trim), "Trim",
-			"Faces farther than this many grid cells from every point are removed (open scans give "
-			"open meshes). 0 keeps the closed surface."));
+			"Every face farther than this many grid cells from every point is removed. 0: only "
+			"past an open scan's border."));
 		pl.addParam(RichBool("estimate_normals", true, "Estimate normals",
 			"Estimate (and orient outward) the normals the point set lacks. When off, the point set "
 			"must have normals."));
@@ -447,6 +455,7 @@ std::map<std::string, QVariant> FilterVstreePlugin::apply(
 		if (levels < 0)
 			throw MLException(QString("vstree: levels must be in [0, 12], got %1").arg(levels));
 		p.max_levels = uint32_t(levels);
+		p.closure = int32_t(par.getEnum("surface"));
 		p.trim = float(par.getFloat("trim"));
 		vstree_reconstruct_result* res = nullptr;
 		check(vstree_reconstruct(in.p, &p, progressTrampoline, &prog, &res), "reconstruct");

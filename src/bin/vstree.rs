@@ -92,14 +92,17 @@ enum Command {
         /// without it).
         #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().trim)]
         trim: f32,
-        /// Keep only the part of the surface that the samples support: for a scan from one
-        /// side (the output's border follows the scan's), or to keep a scan's holes open. By
-        /// default the surface is closed, over holes and the back of an open scan.
-        #[arg(long, conflicts_with = "detect_open")]
+        /// Keep only the part of the surface that the samples support, whatever its share: a
+        /// scan's holes stay open too. By default the output is open only where much of the
+        /// closed surface (30%) is unsupported by the samples, as behind a scan from one side.
+        #[arg(long, conflicts_with = "closed")]
         open: bool,
-        /// Make the output open only when much of the closed surface would be far from every
-        /// sample (experimental: some noisy or sparse closed clouds come out open).
+        /// Always close the surface, over holes and the back of an open scan.
         #[arg(long)]
+        closed: bool,
+        /// Accepted for scripts written for 0.2, where open output was not the default: it
+        /// is now.
+        #[arg(long, hide = true)]
         detect_open: bool,
         /// What decides the base mesh's inside and outside.
         #[arg(long, value_enum, default_value_t = BaseMeshArg::Winding)]
@@ -373,7 +376,8 @@ fn run(command: Command) -> vstree::Result<()> {
             levels,
             trim,
             open,
-            detect_open,
+            closed,
+            detect_open: _,
             base_mesh,
             reorient,
             neighbours,
@@ -386,10 +390,10 @@ fn run(command: Command) -> vstree::Result<()> {
                 target_distance: target,
                 max_levels: levels,
                 trim,
-                closure: match (open, detect_open) {
+                closure: match (open, closed) {
                     (true, _) => Closure::Open,
-                    (_, true) => Closure::Auto,
-                    _ => Closure::Closed,
+                    (_, true) => Closure::Closed,
+                    _ => Closure::Auto,
                 },
                 base_mesh: match base_mesh {
                     BaseMeshArg::Winding => BaseMesh::Winding,
@@ -591,10 +595,10 @@ fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &Reconstruct
     println!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
     let share = 100.0 * s.unsupported_share;
     if s.open {
-        println!("open: {share:.0}% of the closed surface is far from the samples; kept: the part they support");
+        println!("open: {share:.0}% of the closed surface is unsupported by the samples; kept: the part they support (--closed closes it)");
     } else {
         println!(
-            "closed: {share:.0}% of the closed surface is far from the samples, closed over (--open keeps it open)"
+            "closed: {share:.0}% of the closed surface is unsupported by the samples, closed over (--open keeps it open)"
         );
     }
     if s.final_error > FAR_FROM_SAMPLES {

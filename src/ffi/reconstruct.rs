@@ -70,9 +70,9 @@ pub struct vstree_reconstruct_params {
     pub reorient_given: u32,
     /// Worker threads: 0 = all cores (default), else at most 1024. Results do not depend on it.
     pub threads: u32,
-    /// Open or closed output, a VSTREE_CLOSURE_* value. Default VSTREE_CLOSURE_CLOSED; use
-    /// VSTREE_CLOSURE_OPEN for a scan from one side (only the part of the surface the points
-    /// support is kept). Since 0.2.0.
+    /// Open or closed output, a VSTREE_CLOSURE_* value. Default VSTREE_CLOSURE_AUTO (since
+    /// 0.3.0; VSTREE_CLOSURE_CLOSED before): a scan from one side comes out open, a closed
+    /// object closed. Since 0.2.0.
     pub closure: i32,
     /// What decides the base mesh's inside and outside, a VSTREE_BASE_MESH_* value. Default
     /// VSTREE_BASE_MESH_WINDING; VSTREE_BASE_MESH_PAPER is the paper's construction, to compare
@@ -86,8 +86,9 @@ pub const VSTREE_BASE_MESH_WINDING: i32 = 0;
 /// `base_mesh` value: the paper's blend of the T-nodes' planes near the points.
 pub const VSTREE_BASE_MESH_PAPER: i32 = 1;
 
-/// `closure` value: open when more than 15% of the closed surface is far from every point.
-/// Experimental: some noisy or sparse closed clouds come out open.
+/// `closure` value: open when more than 30% of the closed surface is unsupported by the points
+/// (far from all, or near only points facing the other way; a scan from one side leaves about
+/// half), else closed. The default since 0.3.0.
 pub const VSTREE_CLOSURE_AUTO: i32 = 0;
 /// `closure` value: always the closed surface, holes and the back of an open scan closed over.
 pub const VSTREE_CLOSURE_CLOSED: i32 = 1;
@@ -279,8 +280,8 @@ pub struct vstree_reconstruct_stats {
     pub open: u32,
     /// Edges of the base mesh M0 with one face (0 when M0 is closed). Since 0.2.0.
     pub base_boundary_edges: u32,
-    /// Share of the closed polygonised surface's area far from every point (about half for a
-    /// scan from one side); `closure` AUTO makes the output open above 0.15. Since 0.2.0.
+    /// Share of the closed polygonised surface's area unsupported by the points (far from all,
+    /// or near only points facing the other way; about half for a scan from one side); `closure` AUTO makes the output open above 0.3. Since 0.2.0.
     pub unsupported_share: f64,
 }
 
@@ -352,8 +353,8 @@ pub struct vstree_reconstruct_result {
 
 /// Reconstructs a triangle mesh from the points of `cloud` (its triangles, if any, are
 /// ignored): normals are estimated where the cloud has none (all, or zero-length ones), the
-/// VS-Tree of the points is built, its T-nodes give a coarse base mesh (closed, or with
-/// `params->closure` VSTREE_CLOSURE_OPEN only the part the points support), which is refined
+/// VS-Tree of the points is built, its T-nodes give a coarse base mesh (closed, or only the
+/// part the points support where `params->closure` says so), which is refined
 /// by the quadtrees below them until it is close enough to the points; with `params->trim` >
 /// 0, faces far from every point are removed at the end. The output has
 /// unit per-vertex normals and counter-clockwise triangles seen from outside.

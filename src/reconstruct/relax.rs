@@ -4,7 +4,9 @@
 //! place (the paper's suggestion): rounds of Delaunay edge flips where the surface is flat
 //! enough for a flip not to cut a ridge, then tangential relaxation, each vertex put back on the
 //! samples' local fit ([`super::mls`]). Flips keep a manifold's topology (an edge is never
-//! flipped onto one that exists) and border edges and vertices never change.
+//! flipped onto one that exists) and border edges and vertices never change. Each refined
+//! level's new vertices are relaxed the same way ([`relax_level`]), since displacement skews
+//! the split's triangles.
 
 use super::adjacency::Rows;
 use super::mls::{project_vertices, SampleSurface};
@@ -23,6 +25,8 @@ const FLAT_ENOUGH: f32 = 0.9;
 /// A vertex is not relaxed where a neighbour's normal is farther than this cosine from its own
 /// (about 45 degrees): see [`relax`].
 const BENT: f32 = 0.7;
+/// Relaxations of a refinement level's new vertices (see [`relax_level`]).
+const LEVEL_ROUNDS: usize = 2;
 /// Share of the way to its neighbours' mean that a vertex moves in one relaxation.
 const RELAX_STEP: f32 = 0.5;
 
@@ -37,8 +41,20 @@ pub(crate) fn improve(s: &mut Surface, onto: &SampleSurface, reach: f32, threads
     }
 }
 
+/// After a refinement level: [`LEVEL_ROUNDS`] tangential relaxations of the vertices from
+/// `first` on (the level's new ones), before they are projected onto the samples. The 1-to-4
+/// split keeps M0's shapes, but displacement moves a new vertex to its leaf's average sample,
+/// anywhere in the leaf, which skews the triangles around it. `border`: [`border_vertices`].
+pub(crate) fn relax_level(s: &mut Surface, first: usize, border: &[bool], threads: &Threads) {
+    let mut fixed = border.to_vec();
+    fixed[..first].fill(true);
+    for _ in 0..LEVEL_ROUNDS {
+        relax(s, &fixed, threads);
+    }
+}
+
 /// Vertices on an edge that only one triangle has.
-fn border_vertices(triangles: &[[u32; 3]], vertices: usize) -> Vec<bool> {
+pub(crate) fn border_vertices(triangles: &[[u32; 3]], vertices: usize) -> Vec<bool> {
     let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
     for t in triangles {
         for k in 0..3 {
@@ -136,7 +152,7 @@ fn flip_edges(s: &mut Surface) {
 
 /// Moves every vertex not on the border [`RELAX_STEP`] of the way to the mean of its
 /// neighbours, within its tangent plane.
-fn relax(s: &mut Surface, border: &[bool], threads: &Threads) {
+fn relax(s: &mut Surface, fixed: &[bool], threads: &Threads) {
     let neighbours = Rows::neighbours(&s.triangles, s.positions.len());
     let moved: Vec<Vec3> = threads.run(|| {
         (0..s.positions.len())
@@ -144,7 +160,7 @@ fn relax(s: &mut Surface, border: &[bool], threads: &Threads) {
             .map(|v| {
                 let ring = neighbours.of(v as u32);
                 let p = s.positions[v];
-                if border[v] || ring.is_empty() {
+                if fixed[v] || ring.is_empty() {
                     return p;
                 }
                 let n = s.normals[v];
@@ -215,5 +231,41 @@ mod tests {
         assert!(off < 1e-3, "a vertex {off} off the sphere");
         let report = topology::analyze(&Mesh::new(s.positions.clone(), None, s.triangles.clone()));
         assert!(report.is_watertight() && report.genus() == Some(0), "{report:?}");
+    }
+
+    #[test]
+    fn a_refined_levels_new_vertices_are_relaxed_and_the_old_ones_stay() {
+        // An icosphere split once more; the new (mid-edge) vertices slid along the sphere by
+        // up to 60% of an edge, as displacement to a leaf's sample does. Relaxing the level
+        // makes its triangles well shaped again and leaves the old vertices where they were.
+        let coarse = shapes::icosphere(1.0, 2);
+        let fine = shapes::icosphere(1.0, 3);
+        let first = coarse.positions.len();
+        let mut rng = Rng::new(5);
+        let edge = 0.16;
+        let positions: Vec<Vec3> = fine
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(v, &p)| {
+                if v < first {
+                    return p;
+                }
+                let (u, w) = p.any_orthonormal_pair();
+                (p + 1.2 * edge * (u * (rng.f32() - 0.5) + w * (rng.f32() - 0.5))).normalize()
+            })
+            .collect();
+        let mut s = Surface {
+            normals: positions.clone(),
+            labels: vec![0; positions.len()],
+            positions,
+            triangles: fine.triangles.clone(),
+        };
+        let before = thin_share(&s, 20.0);
+        let border = border_vertices(&s.triangles, s.positions.len());
+        relax_level(&mut s, first, &border, &Threads::new(1).unwrap());
+        let after = thin_share(&s, 20.0);
+        assert!(before > 0.08 && after < 0.03, "under 20 degrees: {before} -> {after}");
+        assert!(s.positions[..first] == fine.positions[..first], "an old vertex moved");
     }
 }

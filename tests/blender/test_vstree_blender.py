@@ -52,7 +52,7 @@ def test_registered(addon):
     assert hasattr(bpy.types, "VSTREE_PT_panel")
     ok, msg = addon.core.status()
     assert ok, msg
-    assert "libvstree 0.2.0" in msg
+    assert "libvstree 0.3.0" in msg
 
 
 def test_defaults_are_the_librarys(addon):
@@ -171,6 +171,20 @@ def test_reconstruct_with_normals_watertight(scene):
     r = np.linalg.norm(co.reshape(-1, 3), axis=1)
     assert abs(r.mean() - 1.0) < 0.05
     assert len(cloud.data.polygons) == 0
+
+
+def test_reconstruct_hemisphere_open_by_default_closed_on_request(scene):
+    cloud = sphere_cloud(6000, normals=True)
+    bm = bmesh.new()
+    bm.from_mesh(cloud.data)
+    bmesh.ops.delete(bm, geom=[v for v in bm.verts if v.co.z <= 0], context='VERTS')
+    bm.to_mesh(cloud.data)
+    bm.free()
+    for closure, closed in [('auto', False), ('closed', True)]:
+        bpy.context.view_layer.objects.active = cloud
+        assert bpy.ops.vstree.reconstruct(max_levels=2, closure=closure) == {'FINISHED'}
+        faces = edge_face_counts(bpy.context.active_object.data)
+        assert faces.max() <= 2 and bool(np.all(faces == 2)) == closed, (closure, np.bincount(faces))
 
 
 def test_reconstruct_estimates_normals(scene):

@@ -175,6 +175,7 @@ mlx_reconstruct() { # mlx_reconstruct OUT LEVELS ESTIMATE_NORMALS(true|false)
   <Param type="RichFloat" value="1e-05" name="error"/>
   <Param type="RichAbsPerc" value="0" min="0" max="1" name="distance"/>
   <Param type="RichInt" value="$2" name="levels"/>
+  <Param type="RichEnum" value="0" name="surface" enum_cardinality="3" enum_val0="Auto (open scans stay open)" enum_val1="Closed" enum_val2="Open"/>
   <Param type="RichFloat" value="0" name="trim"/>
   <Param type="RichBool" value="$3" name="estimate_normals"/>
  </filter>

@@ -629,9 +629,10 @@ def reconstruct(cloud, normals=None, progress=None, **params):
     missing normals are estimated and oriented outward. Parameters are the C struct's fields:
     ``error`` (the tree's L2 bound, the de-noising control; default 1e-5), ``max_levels``
     (refinement levels, 0-12; default 6), ``target_distance``, ``min_displaced``,
-    ``max_triangles``, ``max_grid_depth`` (4-20; default 10), ``closure`` ("closed", the default | "open":
-    only the part of the surface the points support, for a scan from one side | "auto": open
-    where much of the closed surface is far from every point), ``base_mesh`` ("winding", the
+    ``max_triangles``, ``max_grid_depth`` (4-20; default 10), ``closure`` ("auto", the default: open
+    where much of the closed surface is far from every point, as behind a scan from one side |
+    "closed": always closed, holes closed over | "open": only the part of the surface the
+    points support, holes kept), ``base_mesh`` ("winding", the
     default: the points' winding number decides inside and outside | "paper": the paper's
     blended T-node planes), ``trim`` (grid cells: every face farther goes; 0, the default,
     trims only past an open scan's border), ``d_a``, ``d_d``, ``max_depth``, ``min_cell_size``, ``orient``

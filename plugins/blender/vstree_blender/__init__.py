@@ -77,6 +77,12 @@ LABEL_KINDS = [
 ]
 
 
+CLOSURES = [
+    ('auto', "Auto", "Open where the points cover one side only (a scan from one view), closed otherwise"),
+    ('closed', "Closed", "Always closed: holes and the back of a scan are closed over"),
+    ('open', "Open", "Only the part of the surface the points support: holes stay open"),
+]
+
 KEEP_TOPOLOGY = [
     ('auto', "Auto", "Keep it when the mesh is closed and manifold; plain clustering otherwise"),
     ('on', "On", "Merge clusters only by collapses that keep the topology (borders stay manifold)"),
@@ -300,9 +306,10 @@ class VSTREE_OT_reconstruct(_Worker, bpy.types.Operator):
     max_grid_depth: IntProperty(
         name="Grid Depth", default=GRID_DEPTH, min=4, max=20, description="Depth of the refinement grid"
     )
+    closure: EnumProperty(name="Surface", items=CLOSURES, default='auto', description="Open or closed output")
     trim: FloatProperty(
         name="Trim", default=TRIM, min=0.0, max=100.0,
-        description="Remove triangles farther than this many grid cells from the points (0 keeps the closed surface)",
+        description="Remove every triangle farther than this many grid cells from the points (0: only past an open scan's border)",
     )
     orient: EnumProperty(name="Orient", items=ORIENTS, default='propagate_outward', description="Orientation of estimated normals")
     neighbours: IntProperty(name="Neighbours", default=NEIGHBOURS, min=3, max=256, description="Neighbours for normal estimation")
@@ -318,7 +325,8 @@ class VSTREE_OT_reconstruct(_Worker, bpy.types.Operator):
     def _native(self, data, progress):
         params = dict(
             error=self.error, max_levels=self.max_levels, max_grid_depth=self.max_grid_depth,
-            trim=self.trim, orient=self.orient, neighbours=self.neighbours, threads=self.threads,
+            closure=self.closure, trim=self.trim, orient=self.orient, neighbours=self.neighbours,
+            threads=self.threads,
         )
         return core.compute_reconstruct(data, params, progress)
 
@@ -386,7 +394,11 @@ class VSTREE_PG_settings(bpy.types.PropertyGroup):
         description="De-noising control of reconstruction (the tree's L2 bound)",
     )
     max_levels: IntProperty(name="Levels", default=RECONSTRUCT_LEVELS, min=0, max=12, description="Refinement levels")
-    trim: FloatProperty(name="Trim", default=TRIM, min=0.0, max=100.0, description="Trim distance in grid cells (0 = closed)")
+    closure: EnumProperty(name="Surface", items=CLOSURES, default='auto', description="Open or closed output")
+    trim: FloatProperty(
+        name="Trim", default=TRIM, min=0.0, max=100.0,
+        description="Trim distance in grid cells (0: only past an open scan's border)",
+    )
     kind: EnumProperty(name="Colour By", items=LABEL_KINDS, default='cluster', description="What gets one colour")
 
 
@@ -420,9 +432,10 @@ class VSTREE_PT_panel(bpy.types.Panel):
         col.label(text="Reconstruct")
         col.prop(s, "recon_error")
         col.prop(s, "max_levels")
+        col.prop(s, "closure")
         col.prop(s, "trim")
         op = col.operator(VSTREE_OT_reconstruct.bl_idname, text="Reconstruct")
-        op.error, op.max_levels, op.trim = s.recon_error, s.max_levels, s.trim
+        op.error, op.max_levels, op.closure, op.trim = s.recon_error, s.max_levels, s.closure, s.trim
         # The sidebar does not wrap labels: a failure's message (which names the zip to
         # install) is shown whole, a line per label.
         for line in [msg] if ok else textwrap.wrap(msg, 60):
