@@ -48,7 +48,8 @@ for platform in $platforms; do
     lib=$(build_library "$platform")
     stage=$root/target/blender/stage/$platform/vstree
     zip=$dist/vstree-$version-${platform/-/_}.zip
-    rm -rf "$stage" "$zip"
+    # Zips of earlier versions for this platform go too: one zip per platform in dist.
+    rm -rf "$stage" "$dist"/vstree-*-"${platform/-/_}".zip
     mkdir -p "$stage/vstree"
     cp plugins/blender/vstree_blender/*.py "$stage/"
     # This zip's manifest names its one platform: Blender refuses it on the others.
