@@ -33,6 +33,10 @@ pub(crate) struct Collapser {
     stamp: u32,
     /// Vertices on a border (an edge with one face), which keep their border manifold.
     border: Vec<bool>,
+    /// With [`Collapser::limit_border_runs`]: the longest box diagonal of the border
+    /// vertices one border vertex may absorb, and per vertex the box (low, high corners) of
+    /// those it has.
+    border_runs: Option<(f64, Vec<[DVec3; 2]>)>,
 }
 
 impl Collapser {
@@ -57,7 +61,25 @@ impl Collapser {
             mark: vec![0; mesh.positions.len()],
             stamp: 1,
             border,
+            border_runs: None,
         }
+    }
+
+    /// From now on, border vertices merge along the border only while the border vertices
+    /// merged lie in a box whose diagonal is at most `length`. A border vertex sits at the mean
+    /// of those it absorbed, so a long run of border cut short to one vertex cuts off the
+    /// surface beside the run's bends; bounding the runs keeps the border within about
+    /// `length` of where it was, however large the clusters are inside.
+    pub(crate) fn limit_border_runs(&mut self, length: f32) {
+        let boxes = self.sum.iter().map(|&p| [p, p]).collect();
+        self.border_runs = Some((f64::from(length), boxes));
+    }
+
+    /// Whether [`Collapser::limit_border_runs`] lets border vertices `u` and `v` merge.
+    fn border_run_fits(&self, u: u32, v: u32) -> bool {
+        let Some((length, boxes)) = &self.border_runs else { return true };
+        let ([lu, hu], [lv, hv]) = (boxes[u as usize], boxes[v as usize]);
+        (hu.max(hv) - lu.min(lv)).length() <= *length
     }
 
     /// Takes face `t` out, with its three corners' vertices.
@@ -112,7 +134,8 @@ impl Collapser {
                     if labels[u as usize] == labels[v as usize]
                         && !touched[u as usize]
                         && !touched[v as usize]
-                        && (!border_only || self.border[u as usize] && self.border[v as usize])
+                        && (!border_only
+                            || self.border[u as usize] && self.border[v as usize] && self.border_run_fits(u, v))
                         && (self.try_collapse(u.max(v), u.min(v)) || border_only && self.cut_ear(u, v))
                     {
                         touched[u as usize] = true;
@@ -203,6 +226,9 @@ impl Collapser {
 
     /// Merges `u` into `v` if the edge exists and the link condition holds.
     fn try_collapse(&mut self, u: u32, v: u32) -> bool {
+        if self.border[u as usize] && self.border[v as usize] && !self.border_run_fits(u, v) {
+            return false;
+        }
         let ok = if self.edge_faces(u, v) == 1 { self.can_collapse_border(u, v) } else { self.can_collapse(u, v) };
         if ok {
             self.merge(u, v);
@@ -305,11 +331,20 @@ impl Collapser {
         let (u, v) = (u as usize, v as usize);
         match (self.border[u], self.border[v]) {
             (false, true) => {}
-            (true, false) => (self.sum[v], self.count[v]) = (self.sum[u], self.count[u]),
+            (true, false) => {
+                (self.sum[v], self.count[v]) = (self.sum[u], self.count[u]);
+                if let Some((_, boxes)) = &mut self.border_runs {
+                    boxes[v] = boxes[u];
+                }
+            }
             _ => {
                 let (sum, count) = (self.sum[u], self.count[u]);
                 self.sum[v] += sum;
                 self.count[v] += count;
+                if let Some((_, boxes)) = &mut self.border_runs {
+                    let ([lu, hu], [lv, hv]) = (boxes[u], boxes[v]);
+                    boxes[v] = [lu.min(lv), hu.max(hv)];
+                }
             }
         }
         self.border[v] |= self.border[u];

@@ -11,7 +11,7 @@
 //! ```text
 //! cargo bench --bench corpus -- [--peers] [--sizes 200000,1000000] [--models bear,igea] [--quick]
 //!     [--reduced] [--no-synthetic] [--methods open3d-poisson8] [--runs N] [--peer-runs N]
-//!     [--max-peer-points N] [--data ../shared/data] [--threads N] [--no-write]
+//!     [--max-peer-points N] [--data ../shared/data] [--threads N] [--clouds] [--no-write]
 //! ```
 
 #[path = "../common/mod.rs"]
@@ -52,6 +52,8 @@ usage: cargo bench --bench corpus -- [options]
   --max-peer-points N   skip the peers on clouds with more points (default 2000000)
   --data DIR            data directory (default ../shared/data, relative to the project root)
   --threads N           vstree's worker threads, 0 = all cores (default 0)
+  --clouds              also write each input cloud (target/bench-corpus/<row>-cloud.ply), to rerun
+                        a row with the CLI
   --no-write            print the report only, do not update docs/benchmarks.md";
 
 /// The peers on every input, and on open inputs only.
@@ -79,6 +81,7 @@ pub struct Options {
     data: PathBuf,
     threads: usize,
     write: bool,
+    clouds: bool,
 }
 
 impl Options {
@@ -99,6 +102,7 @@ impl Options {
             data: root.join("../shared/data"),
             threads: 0,
             write: true,
+            clouds: false,
         };
         let mut sizes_given = false;
         let mut it = args.iter();
@@ -110,6 +114,7 @@ impl Options {
                 "--reduced" => o.reduced = true,
                 "--no-synthetic" => o.synthetic = false,
                 "--no-write" => o.write = false,
+                "--clouds" => o.clouds = true,
                 "--sizes" => {
                     o.sizes = list(value()?)?;
                     sizes_given = true;
@@ -399,6 +404,11 @@ impl Bench<'_> {
         let local_cloud = inputs::local(&case.cloud, case.offset);
         let samples = open.then(|| Samples::new(&local_cloud.positions));
         let stem = case.stem();
+        if self.o.clouds {
+            if let Err(e) = io::write(&self.out_dir.join(format!("{stem}-cloud.ply")), &case.cloud) {
+                eprintln!("corpus: cannot write the cloud: {e}");
+            }
+        }
         let vstree = match reconstruction(&case.cloud, &params, self.o.runs) {
             Ok(rec) => {
                 if let Err(e) = io::write(&self.out_dir.join(format!("{stem}-vstree.ply")), &rec.mesh) {

@@ -111,9 +111,18 @@ impl BaseMesh {
 /// Collapses every edge whose ends share a label, while the link condition allows, and places
 /// each remaining vertex at the mean of the fine vertices it absorbed. Stray components
 /// (bubbles of the implicit function, see [`stray_components`]) are dropped.
-/// `neighbours` are the fine mesh's ([`Rows::neighbours`]).
-pub(crate) fn cluster_at_t_layer(fine: &Mesh, labels: &[u32], neighbours: &Rows, cell: f32) -> BaseMesh {
+/// `neighbours` are the fine mesh's ([`Rows::neighbours`]). On an open mesh, one vertex of
+/// M0 stands for a stretch of border at most `border_run` long (see
+/// [`Collapser::limit_border_runs`]).
+pub(crate) fn cluster_at_t_layer(
+    fine: &Mesh,
+    labels: &[u32],
+    neighbours: &Rows,
+    cell: f32,
+    border_run: f32,
+) -> BaseMesh {
     let mut c = Collapser::new(fine);
+    c.limit_border_runs(border_run);
     let dropped = stray_components(fine, labels, neighbours, cell);
     for (t, tri) in fine.triangles.iter().enumerate() {
         if tri.iter().any(|&v| labels[v as usize] == UNLABELLED || dropped[v as usize]) {
@@ -157,6 +166,7 @@ mod tests {
                 &octant_labels(&mesh),
                 &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
                 0.0,
+                f32::INFINITY,
             );
             let r = analyze(&base.mesh);
             assert!(r.is_watertight(), "{r:?}");
@@ -179,11 +189,53 @@ mod tests {
         let mesh = Mesh::new(sphere.positions.clone(), None, upper);
         let quadrants: Vec<u32> =
             mesh.positions.iter().map(|p| (p.x > 0.0) as u32 | ((p.y > 0.0) as u32) << 1).collect();
-        let base = cluster_at_t_layer(&mesh, &quadrants, &Rows::neighbours(&mesh.triangles, mesh.positions.len()), 0.0);
+        let base = cluster_at_t_layer(
+            &mesh,
+            &quadrants,
+            &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
+            0.0,
+            f32::INFINITY,
+        );
         let r = analyze(&base.mesh);
         assert_eq!(r.non_manifold_edges, 0, "{r:?}");
         assert!(r.boundary_edges >= 3, "{r:?}");
         assert!(base.mesh.positions.len() <= 8, "{} vertices left", base.mesh.positions.len());
+    }
+
+    #[test]
+    fn a_large_open_cluster_keeps_its_border_within_the_run_length() {
+        // A flat 20 x 20 square in four clusters, vertical strips: unbounded, each outer
+        // strip's border (a side and two bits of the others) shrinks to one vertex at its
+        // mean, cutting the square's corners off; with runs of at most 0.3, every corner
+        // stays within 0.3 of an M0 vertex.
+        let n = 20;
+        let positions: Vec<Vec3> = (0..=n)
+            .flat_map(|j| (0..=n).map(move |i| Vec3::new(i as f32 / n as f32, j as f32 / n as f32, 0.0)))
+            .collect();
+        let v = |i: u32, j: u32| j * (n + 1) + i;
+        let triangles = (0..n)
+            .flat_map(|j| {
+                (0..n).flat_map(move |i| {
+                    [[v(i, j), v(i + 1, j), v(i + 1, j + 1)], [v(i, j), v(i + 1, j + 1), v(i, j + 1)]]
+                })
+            })
+            .collect();
+        let mesh = Mesh::new(positions, None, triangles);
+        let labels: Vec<u32> = mesh.positions.iter().map(|p| ((4.0 * p.x) as u32).min(3)).collect();
+        let rows = Rows::neighbours(&mesh.triangles, mesh.positions.len());
+        let corner_gap = |base: &BaseMesh| {
+            [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)]
+                .iter()
+                .map(|c| base.mesh.positions.iter().map(|p| p.distance(*c)).fold(f32::INFINITY, f32::min))
+                .fold(0.0f32, f32::max)
+        };
+        let bounded = cluster_at_t_layer(&mesh, &labels, &rows, 0.0, 0.3);
+        let unbounded = cluster_at_t_layer(&mesh, &labels, &rows, 0.0, f32::INFINITY);
+        assert!(corner_gap(&bounded) < 0.3, "{}", corner_gap(&bounded));
+        assert!(corner_gap(&unbounded) > 0.3, "{}", corner_gap(&unbounded));
+        let r = analyze(&bounded.mesh);
+        assert_eq!(r.non_manifold_edges, 0, "{r:?}");
+        assert!(bounded.mesh.positions.len() < 30, "{} vertices", bounded.mesh.positions.len());
     }
 
     #[test]
@@ -194,6 +246,7 @@ mod tests {
             &vec![0; mesh.positions.len()],
             &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
             0.0,
+            f32::INFINITY,
         );
         assert!(base.mesh.positions.is_empty() && base.mesh.triangles.is_empty());
     }
@@ -207,6 +260,7 @@ mod tests {
             &octant_labels(&mesh),
             &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
             0.0,
+            f32::INFINITY,
         );
         let r = analyze(&base.mesh);
         assert!(r.is_watertight() && r.genus() == Some(0));

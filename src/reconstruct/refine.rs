@@ -176,7 +176,7 @@ impl<'t> Refiner<'t> {
 
         smooth_tangentially(&mut out, old, &displaced, &border);
         self.project_undisplaced(&mut out, old as usize, &displaced);
-        self.unfold(&mut out, old as usize);
+        self.unfold(&mut out, old as usize, &border);
         (out, LevelStats { new_vertices: placed.len(), displaced: moves.len() })
     }
 
@@ -242,16 +242,20 @@ impl<'t> Refiner<'t> {
     /// Unfolds the base mesh where clustering left triangles facing against their corners'
     /// normals (where a T-node is large for the curvature under it): each corner of such a
     /// triangle moves to the mean of its neighbours, then onto the quadtree leaf under that
-    /// point. A few rounds; corners that cannot be unfolded stay where they are.
+    /// point. A few rounds; corners that cannot be unfolded stay where they are, and so do
+    /// border vertices: the mean of a border vertex's neighbours is inside the mesh, so moving
+    /// it there would pull the border inward (a whole region of a large flat T-node when its
+    /// corner folds).
     pub fn unfold_base(&self, s: &mut Surface) {
-        self.unfold(s, 0);
+        self.unfold(s, 0, &super::relax::border_vertices(&s.triangles, s.positions.len()));
     }
 
-    /// [`Refiner::unfold_base`] for the vertices from `first` on (the others stay put).
-    /// After one pass over all triangles, each round looks only at the triangles around the
-    /// vertices it moved: no other triangle can fold or unfold.
-    fn unfold(&self, s: &mut Surface, first: usize) {
-        let mut folded: Vec<usize> = folded_vertices(s).into_iter().filter(|&v| v >= first).collect();
+    /// [`Refiner::unfold_base`] for the vertices from `first` on that `border` does not mark
+    /// (the others stay put). After one pass over all triangles, each round looks only at the
+    /// triangles around the vertices it moved: no other triangle can fold or unfold.
+    fn unfold(&self, s: &mut Surface, first: usize, border: &[bool]) {
+        let movable = |v: &usize| *v >= first && !border[*v];
+        let mut folded: Vec<usize> = folded_vertices(s).into_iter().filter(movable).collect();
         if folded.is_empty() {
             return;
         }
@@ -288,7 +292,7 @@ impl<'t> Refiner<'t> {
                 .flat_map(|&v| faces.of(v as u32))
                 .filter(|&&t| is_folded(s, &s.triangles[t as usize]))
                 .flat_map(|&t| s.triangles[t as usize].map(|w| w as usize))
-                .filter(|&w| w >= first)
+                .filter(movable)
                 .collect();
             still.sort_unstable();
             still.dedup();
