@@ -19,6 +19,20 @@ pub const MAX_SUBDIVISIONS: u32 = 10;
 /// so 513^3 points take 1.2 GB.
 pub const MAX_RESOLUTION: u32 = 512;
 
+/// The unit square [0, 1]² in the plane z = 0 as an `n` x `n` grid of quads, two triangles each
+/// (an open, flat mesh with `(n + 1)²` vertices).
+pub fn square_grid(n: u32) -> Mesh {
+    let positions =
+        (0..=n).flat_map(|j| (0..=n).map(move |i| Vec3::new(i as f32 / n as f32, j as f32 / n as f32, 0.0))).collect();
+    let v = |i: u32, j: u32| j * (n + 1) + i;
+    let triangles = (0..n)
+        .flat_map(|j| {
+            (0..n).flat_map(move |i| [[v(i, j), v(i + 1, j), v(i + 1, j + 1)], [v(i, j), v(i + 1, j + 1), v(i, j + 1)]])
+        })
+        .collect();
+    Mesh::new(positions, None, triangles)
+}
+
 /// A sphere of `|radius|` centred at the origin: a regular icosahedron whose triangles are split
 /// 1-to-4 `subdivisions` times (clamped to [`MAX_SUBDIVISIONS`]), with every vertex projected
 /// onto the sphere. It has 10 * 4^s + 2 vertices and 20 * 4^s triangles, genus 0, and its normals

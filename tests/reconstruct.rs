@@ -402,17 +402,7 @@ fn distance_to_segments(p: Vec3, segments: &[[Vec3; 2]]) -> f32 {
 
 /// The vertices on an edge that only one face has.
 fn border_vertices(mesh: &Mesh) -> Vec<usize> {
-    let mut edges: Vec<(u32, u32)> = mesh
-        .triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
-        .collect();
-    edges.sort_unstable();
-    let mut out: Vec<usize> = edges
-        .chunk_by(|a, b| a == b)
-        .filter(|run| run.len() == 1)
-        .flat_map(|run| [run[0].0 as usize, run[0].1 as usize])
-        .collect();
+    let mut out: Vec<usize> = border_edges(mesh).iter().flatten().map(|&v| v as usize).collect();
     out.sort_unstable();
     out.dedup();
     out

@@ -208,19 +208,7 @@ mod tests {
         // strip's border (a side and two bits of the others) shrinks to one vertex at its
         // mean, cutting the square's corners off; with runs of at most 0.3, every corner
         // stays within 0.3 of an M0 vertex.
-        let n = 20;
-        let positions: Vec<Vec3> = (0..=n)
-            .flat_map(|j| (0..=n).map(move |i| Vec3::new(i as f32 / n as f32, j as f32 / n as f32, 0.0)))
-            .collect();
-        let v = |i: u32, j: u32| j * (n + 1) + i;
-        let triangles = (0..n)
-            .flat_map(|j| {
-                (0..n).flat_map(move |i| {
-                    [[v(i, j), v(i + 1, j), v(i + 1, j + 1)], [v(i, j), v(i + 1, j + 1), v(i, j + 1)]]
-                })
-            })
-            .collect();
-        let mesh = Mesh::new(positions, None, triangles);
+        let mesh = crate::shapes::square_grid(20);
         let labels: Vec<u32> = mesh.positions.iter().map(|p| ((4.0 * p.x) as u32).min(3)).collect();
         let rows = Rows::neighbours(&mesh.triangles, mesh.positions.len());
         let corner_gap = |base: &BaseMesh| {

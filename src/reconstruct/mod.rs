@@ -869,28 +869,12 @@ fn remove_faces(mesh: &mut Mesh, gone: &[bool]) -> usize {
 mod tests {
     use super::*;
 
-    /// A flat square of n x n quads over [0, 1]², two triangles each.
-    fn square(n: u32) -> Mesh {
-        let positions = (0..=n)
-            .flat_map(|j| (0..=n).map(move |i| Vec3::new(i as f32 / n as f32, j as f32 / n as f32, 0.0)))
-            .collect();
-        let v = |i: u32, j: u32| j * (n + 1) + i;
-        let triangles = (0..n)
-            .flat_map(|j| {
-                (0..n).flat_map(move |i| {
-                    [[v(i, j), v(i + 1, j), v(i + 1, j + 1)], [v(i, j), v(i + 1, j + 1), v(i, j + 1)]]
-                })
-            })
-            .collect();
-        Mesh::new(positions, None, triangles)
-    }
-
     #[test]
     fn the_border_is_cut_back_to_the_samples_not_a_face_short_of_them() {
         // Faces 0.1 wide over [0, 1]², samples on x <= 0.43 only: the border goes to 0.45
         // (0.02 past the samples) on the whole right side, where removing faces alone would
         // leave it at 0.4 or 0.5.
-        let mut mesh = square(10);
+        let mut mesh = crate::shapes::square_grid(10);
         let samples: Vec<Vec3> =
             (0..=43).flat_map(|i| (0..=100).map(move |j| Vec3::new(i as f32 * 0.01, j as f32 * 0.01, 0.0))).collect();
         let near = PointBvh::new(&samples);
