@@ -12,6 +12,14 @@ pub fn wants_help(args: &[String]) -> bool {
     args.iter().any(|a| a == "--help" || a == "-h")
 }
 
+/// The options `parsed` from the command line, or else its message on stderr and exit code 2.
+pub fn or_exit<T>(parsed: Result<T, String>) -> T {
+    parsed.unwrap_or_else(|message| {
+        eprintln!("{message}");
+        std::process::exit(2)
+    })
+}
+
 /// The command line as the report shows it: `cargo bench --bench <name> -- <args>`.
 pub fn command(bench: &str, args: &[String]) -> String {
     if args.is_empty() {

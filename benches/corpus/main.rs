@@ -209,13 +209,7 @@ fn main() {
         println!("{USAGE}");
         return;
     }
-    let options = match Options::parse(&args, &root) {
-        Ok(o) => o,
-        Err(message) => {
-            eprintln!("{message}");
-            std::process::exit(2);
-        }
-    };
+    let options = common::cli::or_exit(Options::parse(&args, &root));
     match run(&options, &root, common::cli::command("corpus", &args)) {
         Ok(report) => common::report::publish(&root, "corpus", &report.markdown(), options.write),
         Err(e) => {

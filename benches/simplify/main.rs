@@ -127,13 +127,7 @@ fn main() {
         println!("{USAGE}");
         return;
     }
-    let options = match Options::parse(&args, &root) {
-        Ok(o) => o,
-        Err(message) => {
-            eprintln!("{message}");
-            std::process::exit(2);
-        }
-    };
+    let options = common::cli::or_exit(Options::parse(&args, &root));
     match run(&options, &root, common::cli::command("simplify", &args)) {
         Ok(report) => {
             common::report::publish(&root, "simplify", &report.markdown(), options.write);

@@ -122,13 +122,7 @@ fn main() {
         memory_child(&args[1..], &root);
         return;
     }
-    let options = match Options::parse(&args, &root) {
-        Ok(o) => o,
-        Err(message) => {
-            eprintln!("{message}");
-            std::process::exit(2);
-        }
-    };
+    let options = common::cli::or_exit(Options::parse(&args, &root));
     match run(&options, &root, common::cli::command("table1", &args)) {
         Ok(report) => common::report::publish(&root, "table1", &report.markdown(), options.write),
         Err(e) => {

@@ -138,13 +138,7 @@ fn main() {
         memory_child(&args[1..], &root);
         return;
     }
-    let options = match Options::parse(&args, &root) {
-        Ok(o) => o,
-        Err(message) => {
-            eprintln!("{message}");
-            std::process::exit(2);
-        }
-    };
+    let options = common::cli::or_exit(Options::parse(&args, &root));
     match run(&options, &root, common::cli::command("table2", &args)) {
         Ok(report) => common::report::publish(&root, "table2", &report.markdown(), options.write),
         Err(e) => {

@@ -799,7 +799,9 @@ fn trim_far_faces(mesh: &mut Mesh, samples: &PointBvh, distance: f32, threads: &
             })
             .collect()
     });
-    remove_faces(mesh, &far)
+    let before = mesh.triangles.len();
+    remove_faces(mesh, &far);
+    before - mesh.triangles.len()
 }
 
 /// Cuts an open output's border back to `distance` from the samples; how many faces went.
@@ -815,8 +817,10 @@ fn trim_border(mesh: &mut Mesh, samples: &PointBvh, distance: f32, threads: &Thr
     let far: Vec<bool> = mesh.triangles.iter().map(|t| t.iter().all(|&v| !vertex_near[v as usize])).collect();
     let (region, regions) = support::regions(mesh, &far);
     let cut: Vec<bool> = region.iter().map(|&r| r != u32::MAX && regions[r as usize].touches_border).collect();
-    let removed = remove_faces(mesh, &cut);
-    let vertex_near: Vec<bool> = threads.run(|| mesh.positions.par_iter().map(|&p| near(p)).collect());
+    let before = mesh.triangles.len();
+    let kept = remove_faces(mesh, &cut);
+    let removed = before - mesh.triangles.len();
+    let vertex_near: Vec<bool> = kept.iter().map(|&v| vertex_near[v]).collect();
     let border = relax::border_vertices(&mesh.triangles, mesh.positions.len());
     let neighbours = adjacency::Rows::neighbours(&mesh.triangles, mesh.positions.len());
     let moved: Vec<(usize, Vec3)> = threads.run(|| {
@@ -854,15 +858,15 @@ fn trim_border(mesh: &mut Mesh, samples: &PointBvh, distance: f32, threads: &Thr
     removed
 }
 
-/// Removes the faces `gone` marks, and the vertices left unused; how many faces went.
-fn remove_faces(mesh: &mut Mesh, gone: &[bool]) -> usize {
-    let before = mesh.triangles.len();
+/// Removes the faces `gone` marks, and the vertices left unused; the old index of each vertex
+/// kept.
+fn remove_faces(mesh: &mut Mesh, gone: &[bool]) -> Vec<usize> {
     let mut g = gone.iter();
     mesh.triangles.retain(|_| !*g.next().unwrap_or(&false));
     let kept = renumber_used_vertices(&mut mesh.triangles, mesh.positions.len());
     mesh.positions = kept.iter().map(|&v| mesh.positions[v]).collect();
     mesh.normals = mesh.normals.as_ref().map(|n| kept.iter().map(|&v| n[v]).collect());
-    before - mesh.triangles.len()
+    kept
 }
 
 #[cfg(test)]
