@@ -1,18 +1,11 @@
 //! Every real model in `../shared/data` loads with the counts its README gives.
-//! The folder is not part of the repository; without it these tests pass with a message.
+//! The folder is not part of the repository; without it these tests pass with a message (and
+//! fail under CI).
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::data_dir;
 use vstree::io;
-
-fn data_dir() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skipping: ../shared/data not found");
-        None
-    }
-}
 
 /// `(file, vertices, faces, has normals)` from the README; `None` where it gives no exact count.
 const EXPECTED: &[(&str, Option<usize>, usize, bool)] = &[

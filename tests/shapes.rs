@@ -1,5 +1,7 @@
 //! Generated shapes, topology figures and distances, asserted on figures whose answer is known.
 
+mod common;
+
 use glam::Vec3;
 use std::path::Path;
 use vstree::distance::{chamfer_and_hausdorff, one_sided, point_to_mesh_distances, Target, TriangleBvh};
@@ -328,17 +330,10 @@ fn read_off(path: &Path) -> Mesh {
 
 #[test]
 fn real_meshes_have_their_documented_genus() {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
-    if !data.is_dir() {
-        eprintln!("skipping: {} is absent", data.display());
-        return;
-    }
+    let Some(data) = common::data_dir() else { return };
     for (file, genus) in [("3holes.off", 3), ("fertility_20k.off", 4), ("eight.off", 2), ("knot1.off", 1)] {
         let path = data.join(file);
-        if !path.is_file() {
-            eprintln!("skipping: {} is absent", path.display());
-            continue;
-        }
+        assert!(path.is_file(), "{} not found", path.display());
         let mesh = read_off(&path);
         let report = analyze(&mesh);
         assert!(report.is_watertight(), "{file}: {report:?}");

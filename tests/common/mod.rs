@@ -1,5 +1,5 @@
 //! Shared helpers for the integration tests: the real models in `../shared/data` (skipped with
-//! a message when absent) and the samples of a mesh or cloud.
+//! a message when absent, a failure under CI) and the samples of a mesh or cloud.
 #![allow(dead_code)]
 
 pub mod ffi;
@@ -8,20 +8,28 @@ pub mod scratch;
 use std::path::PathBuf;
 use vstree::{Mesh, MeshSampling, SampleSet};
 
-/// `../shared/data`, or `None` (after saying so) when it is not there.
+/// The real models' folder: `VSTREE_DATA` when set, else `../shared/data`; `None` (after
+/// saying so) when it is absent. Where the models are expected (`CI` or `VSTREE_DATA` set), an
+/// absent folder fails the test instead, so a run without them cannot pass silently.
 pub fn data_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    let named = std::env::var_os("VSTREE_DATA").map(PathBuf::from);
+    let expected = named.is_some() || std::env::var_os("CI").is_some();
+    let dir = named.unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
     if dir.is_dir() {
         Some(dir)
+    } else if expected {
+        panic!("{} not found, and CI or VSTREE_DATA says the real models must be there", dir.display());
     } else {
-        eprintln!("skipping: ../shared/data not found");
+        eprintln!("skipping: {} not found", dir.display());
         None
     }
 }
 
-/// Loads `../shared/data/<name>`, or `None` when the folder is absent.
+/// Loads model `name` from [`data_dir`], or `None` when the folder is absent (and the models are
+/// not expected). A model missing from a folder that is there fails the test.
 pub fn load(name: &str) -> Option<Mesh> {
     let path = data_dir()?.join(name);
+    assert!(path.is_file(), "{} not found", path.display());
     Some(vstree::io::read(&path).unwrap_or_else(|e| panic!("{name}: {e}")))
 }
 

@@ -34,7 +34,7 @@ JOBS=${JOBS:-2}
 mirror=${DEBIAN_MIRROR:-http://deb.debian.org/debian}
 cache=${XDG_CACHE_HOME:-$HOME/.cache}/vstree/chroots
 work=$root/target/hosts
-data=$(cd "$root/.." && pwd)/shared/data
+data=${VSTREE_DATA:-$(cd "$root/.." && pwd)/shared/data}
 systems=" ${VSTREE_HOSTS_SYSTEMS:-debian13 sid debian12} "
 apps=" ${VSTREE_HOSTS_APPS:-blender meshlab} "
 
@@ -74,6 +74,10 @@ skip() {
     echo "SKIP $*"
     echo "SKIP $*" >>"$results"
 }
+# Under CI (or with VSTREE_DATA set) the shared models must be there: their checks are not skipped.
+if [ ! -d "$data" ] && { [ -n "${CI:-}" ] || [ -n "${VSTREE_DATA:-}" ]; }; then
+    fail "no $data, and CI or VSTREE_DATA says the shared models must be there"
+fi
 summary() {
     local p f s
     p=$(grep -c '^PASS' "$results" || true)
