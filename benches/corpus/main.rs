@@ -30,7 +30,7 @@ use report::{Context, PeerRow, Report, Row};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use vstree::normals::{ensure_normals, NormalParams};
-use vstree::reconstruct::ReconstructParams;
+use vstree::reconstruct::{BaseMesh, ReconstructParams};
 use vstree::{io, Mesh, Progress};
 
 const USAGE: &str = "\
@@ -52,6 +52,8 @@ usage: cargo bench --bench corpus -- [options]
   --max-peer-points N   skip the peers on clouds with more points (default 2000000)
   --data DIR            data directory (default ../shared/data, relative to the project root)
   --threads N           vstree's worker threads, 0 = all cores (default 0)
+  --base-mesh paper     vstree's base mesh from the paper's blended T-node planes instead of the
+                        default winding number (to compare the two)
   --clouds              also write each input cloud (target/bench-corpus/<row>-cloud.ply), to rerun
                         a row with the CLI
   --no-write            print the report only, do not update docs/benchmarks.md";
@@ -82,6 +84,7 @@ pub struct Options {
     threads: usize,
     write: bool,
     clouds: bool,
+    base_mesh: BaseMesh,
 }
 
 impl Options {
@@ -103,6 +106,7 @@ impl Options {
             threads: 0,
             write: true,
             clouds: false,
+            base_mesh: BaseMesh::default(),
         };
         let mut sizes_given = false;
         let mut it = args.iter();
@@ -131,6 +135,13 @@ impl Options {
                 "--max-peer-points" => o.max_peer_points = number(value()?)?,
                 "--threads" => o.threads = number(value()?)?,
                 "--data" => o.data = PathBuf::from(value()?),
+                "--base-mesh" => {
+                    o.base_mesh = match value()?.as_str() {
+                        "paper" => BaseMesh::Paper,
+                        "winding" => BaseMesh::Winding,
+                        v => return Err(format!("--base-mesh {v}: paper or winding")),
+                    }
+                }
                 other => return Err(format!("unknown option {other}\n{USAGE}")),
             }
         }
@@ -278,6 +289,9 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
         total,
         start: Instant::now(),
     };
+    if o.base_mesh == BaseMesh::Paper {
+        bench.notes.push("vstree's base mesh: the paper's blended T-node planes (`--base-mesh paper`).".into());
+    }
 
     let mut skipped = Vec::new();
     for model in &models {
@@ -394,7 +408,8 @@ impl Bench<'_> {
         );
         let open = case.truth.open;
         // Defaults on every input: open or closed is found, not told.
-        let params = ReconstructParams { threads: self.o.threads, ..ReconstructParams::default() };
+        let params =
+            ReconstructParams { threads: self.o.threads, base_mesh: self.o.base_mesh, ..ReconstructParams::default() };
         let local_cloud = inputs::local(&case.cloud, case.offset);
         let samples = open.then(|| Samples::new(&local_cloud.positions));
         let stem = case.stem();
