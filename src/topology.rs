@@ -7,6 +7,7 @@
 //! fraction of a second.
 
 use crate::mesh::Mesh;
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// Topological figures of a mesh, as computed by [`analyze`].
@@ -285,6 +286,49 @@ fn is_single_fan(v: u32, fan: &[u32], faces: &[[u32; 3]]) -> bool {
     degree.iter().all(|&d| d <= 2) && (1..link_vertices.len() as u32).all(|x| uf.find(x) == root)
 }
 
+/// The pairs of faces that share an edge (every pair on a non-manifold edge).
+pub fn adjacent_face_pairs(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut pairs = Vec::with_capacity(3 * triangles.len() / 2);
+    for run in sorted_half_edges(triangles).chunk_by(|a, b| a.key == b.key) {
+        for (i, first) in run.iter().enumerate() {
+            for second in &run[i + 1..] {
+                pairs.push([first, second].map(|h| (h.face_and_direction >> 1) as u32));
+            }
+        }
+    }
+    pairs
+}
+
+/// Of `pairs` ([`adjacent_face_pairs`]), those whose normals differ by more than `degrees`:
+/// folds, where one face lies back over the other (faces with an index out of range or no
+/// area have no normal and never fold).
+pub fn folded_face_pairs(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    pairs: &[[u32; 2]],
+    degrees: f32,
+) -> Vec<[u32; 2]> {
+    let normals: Vec<Vec3> = triangles
+        .par_iter()
+        .map(|tri| {
+            if !is_valid_face(tri, positions.len()) {
+                return Vec3::ZERO;
+            }
+            let [a, b, c] = tri.map(|v| positions[v as usize]);
+            (b - a).cross(c - a).normalize_or_zero()
+        })
+        .collect();
+    let limit = degrees.to_radians().cos();
+    pairs
+        .par_iter()
+        .copied()
+        .filter(|&[f, g]| {
+            let (m, n) = (normals[f as usize], normals[g as usize]);
+            m != Vec3::ZERO && n != Vec3::ZERO && m.dot(n) < limit
+        })
+        .collect()
+}
+
 /// The valence (number of distinct neighbours along edges) of every vertex in `positions`;
 /// unreferenced vertices have valence 0. Degenerate faces are ignored.
 pub fn valences(mesh: &Mesh) -> Vec<u32> {
@@ -345,7 +389,29 @@ pub fn surface_area(mesh: &Mesh) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
+
+    #[test]
+    fn folded_face_pairs_are_the_pairs_turned_back_over_their_edge() {
+        // Faces on the edge (0, 1): a flat neighbour, one folded back (179 degrees), one at
+        // 90 degrees, and a degenerate one (no normal).
+        let positions = vec![
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::new(0.5, 1.0, 0.0),
+            Vec3::new(0.5, -1.0, 0.0),
+            Vec3::new(0.5, 0.8, 0.01),
+            Vec3::new(0.5, 0.0, 1.0),
+            Vec3::new(2.0, 0.0, 0.0),
+        ];
+        let flat = vec![[0, 1, 2], [1, 0, 3]];
+        assert_eq!(adjacent_face_pairs(&flat), vec![[0, 1]]);
+        assert!(folded_face_pairs(&positions, &flat, &adjacent_face_pairs(&flat), 150.0).is_empty());
+        let faces = vec![[0, 1, 2], [1, 0, 4], [1, 0, 5], [1, 0, 6]];
+        let pairs = adjacent_face_pairs(&faces);
+        assert_eq!(pairs.len(), 6, "every pair of the four faces on one edge");
+        assert_eq!(folded_face_pairs(&positions, &faces, &pairs, 150.0), vec![[0, 1]]);
+        assert_eq!(folded_face_pairs(&positions, &faces, &pairs, 80.0).len(), 3);
+    }
 
     #[test]
     fn closed_surface_genus_agrees_with_the_full_analysis() {

@@ -76,6 +76,10 @@ fn assert_closed_reconstruction(name: &str, cloud: &Mesh, genus: u32) {
     // Measured 0 on every one; at most 0.23% (fertility) before each level was unfolded
     // onto the samples' fit.
     assert!(folded_share(&mesh) < 1e-4, "{name}: {:.3}% folded triangles", 100.0 * folded_share(&mesh));
+    // Nor any pair of triangles folded onto each other (the benchmark's folds, 150 degrees).
+    let pairs = topology::adjacent_face_pairs(&mesh.triangles);
+    let folds = topology::folded_face_pairs(&mesh.positions, &mesh.triangles, &pairs, 150.0).len();
+    assert_eq!(folds, 0, "{name}: {folds} folds");
     // Remeshing-grade triangles (issue 13's targets): measured at most 0.32% under 10 degrees
     // and 1.73% under 20 (fertility).
     assert!(thin.0 < 0.01 && thin.1 < 0.05, "{name}: {thin:?} under 10 and 20 degrees");

@@ -109,44 +109,6 @@ pub fn quality(output: &Mesh, truth: &Truth, samples: Option<&Samples>) -> Quali
 /// Edges whose faces' normals differ by more than [`FOLD_DEGREES`] (every pair of faces on a
 /// non-manifold edge counts; degenerate faces have no normal and never fold).
 pub fn folds(mesh: &Mesh) -> usize {
-    let p = &mesh.positions;
-    let normals: Vec<Vec3> = mesh
-        .triangles
-        .par_iter()
-        .map(|t| {
-            if t.iter().any(|&i| i as usize >= p.len()) {
-                return Vec3::ZERO;
-            }
-            let [a, b, c] = t.map(|i| p[i as usize]);
-            (b - a).cross(c - a).normalize_or_zero()
-        })
-        .collect();
-    let mut edges: Vec<(u64, u32)> = mesh
-        .triangles
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(f, t)| {
-            (0..3).map(move |k| {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                ((u64::from(a.min(b)) << 32) | u64::from(a.max(b)), f as u32)
-            })
-        })
-        .collect();
-    edges.par_sort_unstable();
-    let limit = FOLD_DEGREES.to_radians().cos() as f32;
-    edges
-        .chunk_by(|x, y| x.0 == y.0)
-        .map(|group| {
-            let mut count = 0;
-            for (i, &(_, f)) in group.iter().enumerate() {
-                for &(_, g) in &group[i + 1..] {
-                    let (m, n) = (normals[f as usize], normals[g as usize]);
-                    if m != Vec3::ZERO && n != Vec3::ZERO && m.dot(n) < limit {
-                        count += 1;
-                    }
-                }
-            }
-            count
-        })
-        .sum()
+    let pairs = vstree::topology::adjacent_face_pairs(&mesh.triangles);
+    vstree::topology::folded_face_pairs(&mesh.positions, &mesh.triangles, &pairs, FOLD_DEGREES as f32).len()
 }

@@ -10,7 +10,7 @@
 
 use super::adjacency::Rows;
 use super::leaf_fit::solve;
-use super::refine::{folded_vertices, Surface};
+use super::refine::{folded_or_creased_vertices, folded_vertices, Surface};
 use crate::knn::KdTree;
 use crate::progress::Threads;
 use crate::tree::TreeSample;
@@ -180,13 +180,16 @@ pub(crate) fn project_vertices(s: &mut Surface, first: usize, onto: &SampleSurfa
 /// Rounds of [`unfold`]; from the second on the region grows by a ring each round.
 const UNFOLD_ROUNDS: usize = 4;
 
-/// Unfolds `s` where a triangle faces against its corners' normals (a displaced vertex slid
-/// over its neighbours, or two fits of a thin part disagree): each corner of such a triangle
+/// Unfolds `s` where a triangle faces against its corners' normals or folds onto its neighbour
+/// ([`folded_or_creased_vertices`]: a displaced vertex slid over its neighbours, or two fits of
+/// a thin part disagree): each corner of such a triangle
 /// goes to the mean of its neighbours and back onto the samples' surface, in rounds. From the
 /// second round on, the ring around the vertices still folded moves too: a fold pinned by
 /// its own neighbours needs room. Vertices `border` marks stay.
 pub(crate) fn unfold(s: &mut Surface, border: &[bool], onto: &SampleSurface, reach: f32, threads: &Threads) {
-    let mut folded = folded_vertices(s);
+    // The triangles stay the same while their corners move: which faces meet is found once.
+    let pairs = threads.run(|| crate::topology::adjacent_face_pairs(&s.triangles));
+    let mut folded = threads.run(|| folded_or_creased_vertices(s, &pairs));
     if folded.is_empty() {
         return;
     }
@@ -218,7 +221,7 @@ pub(crate) fn unfold(s: &mut Surface, border: &[bool], onto: &SampleSurface, rea
             s.positions[v] = p;
             s.normals[v] = n;
         }
-        folded = folded_vertices(s);
+        folded = threads.run(|| folded_or_creased_vertices(s, &pairs));
         if folded.is_empty() {
             return;
         }
@@ -303,6 +306,41 @@ pub(crate) mod tests {
         let border = vec![false; s.positions.len()];
         unfold(&mut s, &border, &onto, 0.2, &threads);
         assert!(folded_vertices(&s).is_empty(), "still folded: {:?}", folded_vertices(&s));
+        let off = s.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max);
+        assert!(off < 1e-3, "a vertex {off} off the sphere");
+    }
+
+    #[test]
+    fn a_fold_whose_corner_normals_turned_with_it_is_unfolded_too() {
+        // As above, but every vertex's normal is its faces' mean, as a fit's normal turns with a
+        // fold: the corners' normals no longer tell the folded triangles, their dihedral angles do.
+        let sphere = crate::shapes::icosphere(1.0, 3);
+        let mut s = Surface {
+            normals: sphere.positions.clone(),
+            labels: vec![0; sphere.positions.len()],
+            positions: sphere.positions.clone(),
+            triangles: sphere.triangles.clone(),
+        };
+        for v in [10, 200, 400] {
+            let p = s.positions[v];
+            let (u, _) = p.any_orthonormal_pair();
+            s.positions[v] = (p + 0.4 * u).normalize();
+        }
+        let mut normals = vec![Vec3::ZERO; s.positions.len()];
+        for t in &s.triangles {
+            let [a, b, c] = t.map(|v| s.positions[v as usize]);
+            for &v in t {
+                normals[v as usize] += (b - a).cross(c - a);
+            }
+        }
+        s.normals = normals.into_iter().map(Vec3::normalize_or_zero).collect();
+        let threads = Threads::new(1).unwrap();
+        let samples = sphere_samples(20_000, 1.0);
+        let onto = SampleSurface::new(&samples, &threads).unwrap();
+        let border = vec![false; s.positions.len()];
+        unfold(&mut s, &border, &onto, 0.2, &threads);
+        let left = folded_or_creased_vertices(&s, &crate::topology::adjacent_face_pairs(&s.triangles));
+        assert!(left.is_empty(), "still folded: {left:?}");
         let off = s.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max);
         assert!(off < 1e-3, "a vertex {off} off the sphere");
     }
