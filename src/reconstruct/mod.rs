@@ -380,18 +380,19 @@ pub fn reconstruct(
     let measured = evenly_spread(&samples.positions, ERROR_SAMPLES);
     drop(samples);
     let tree_order: Vec<Vec3> = tree.samples.iter().map(|s| s.position).collect();
-    let near = threads.run(|| PointBvh::new(&tree_order));
-    let spacing = sample_spacing(&near, &tree_order);
+    let sample_index = threads.run(|| PointBvh::new(&tree_order));
+    let spacing = sample_spacing(&sample_index, &tree_order);
     let grid = polygonisation_grid(&tree, params.max_grid_depth, spacing);
     stats.grid_cells = grid.dims[0] - 5;
     drop(tree_order);
     // Distances from the samples count in grid cells, or in sample spacings where the samples
     // are sparser than the grid.
-    let unit = grid.cell.max(spacing);
+    let distance_unit = grid.cell.max(spacing);
     // A T-node's plane strays from its samples by up to its patch's sag, so the cap on the
     // distance to the samples must leave room for the typical T-node too.
     let typical_t_half = median(tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| n.half).collect());
-    let far = OUTSIDE_BEYOND * unit.max(typical_t_half);
+    // Beyond this distance from every sample only the winding number's side counts.
+    let side_only_beyond = OUTSIDE_BEYOND * distance_unit.max(typical_t_half);
     // A sparse cloud's leaves are smaller than the surface their few samples stand for: each
     // sample stands for at least a square of the spacing (exactly that on a regular grid).
     let (softening, min_sample_area) = match params.base_mesh {
@@ -401,7 +402,9 @@ pub fn reconstruct(
     let winding = winding::WindingNumber::new(&tree, min_sample_area).softened(softening);
     let onto_samples = mls::SampleSurface::new(&tree.samples, &threads)?;
     let blend = implicit::PlaneBlend::new(&tree, SUPPORT_SCALE, 1.5 * grid.cell);
-    let tolerance = FAR_FROM_SAMPLES * unit;
+    // Within this distance of the samples, planes (the T-nodes', or near an open scan's
+    // border the samples' own) may decide the side; see FAR_FROM_SAMPLES.
+    let planes_within = FAR_FROM_SAMPLES * distance_unit;
     // Open asked for; `Auto` first polygonises as for a closed output and, if that finds an
     // open scan, again as for an open one.
     let asked_open = params.closure == Closure::Open || params.trim > 0.0;
@@ -409,9 +412,9 @@ pub fn reconstruct(
         let inside_above = if open { OPEN_SCAN_INSIDE } else { 0.5 };
         match params.base_mesh {
             BaseMesh::Winding => {
-                let d = near.distance_within(p, far).min(far);
+                let d = sample_index.distance_within(p, side_only_beyond).min(side_only_beyond);
                 let w = winding.at(p);
-                let inside = if open && d <= tolerance && (w - 0.5).abs() < WINDING_DOUBT {
+                let inside = if open && d <= planes_within && (w - 0.5).abs() < WINDING_DOUBT {
                     // Next to the samples where the winding number is in doubt (an open scan's
                     // falls towards its border, so its level set leaves the samples there), their
                     // own tangent planes tell the side. Not for a closed output: there the level
@@ -427,7 +430,9 @@ pub fn reconstruct(
                     d
                 }
             }
-            BaseMesh::Paper => paper_function(p, &near, &blend, &winding, inside_above, tolerance, far),
+            BaseMesh::Paper => {
+                paper_function(p, &sample_index, &blend, &winding, inside_above, planes_within, side_only_beyond)
+            }
         }
     };
     // Polygonised `offset` outside the zero set, from the cells the surface should cross.
@@ -464,10 +469,10 @@ pub fn reconstruct(
             move_inward(&mut fine, &neighbours, THICKEN_CELLS * grid.cell, &threads);
         }
         let labels = threads.run(|| base_mesh::label_vertices(&tree, &fine, &neighbours));
-        let reach = support::SUPPORT_REACH * unit;
+        let reach = support::SUPPORT_REACH * distance_unit;
         let face_reach =
             |f: usize| reach + sag.get(labels[fine.triangles[f][0] as usize] as usize).copied().unwrap_or(0.0);
-        let support = support::supported_faces(&fine, &near, &sample_normals, face_reach, &threads);
+        let support = support::supported_faces(&fine, &sample_index, &sample_normals, face_reach, &threads);
         // Faces that no sample supports: far from all, or near only samples facing the other
         // way (the closing sheet right behind an open scan).
         let unsupported: Vec<bool> = support.iter().map(|&s| s != support::Support::Supported).collect();
@@ -527,7 +532,7 @@ pub fn reconstruct(
     refiner.snap_base(&mut surface);
     refiner.unfold_base(&mut surface);
     // M0's vertices are off by up to their T-node's sag, later ones by less.
-    let mls_reach = MLS_REACH * unit.max(typical_t_half);
+    let mls_reach = MLS_REACH * distance_unit.max(typical_t_half);
     mls::project_vertices(&mut surface, 0, &onto_samples, mls_reach, &threads);
     relax::improve(&mut surface, &onto_samples, mls_reach, &threads);
     let (mut rms, mut max) = sample_error(&mut surface, &measured, tree.diagonal, &threads);
@@ -583,9 +588,9 @@ pub fn reconstruct(
         // An explicit `trim` removes every face farther than it. Otherwise the border is cut
         // back to BORDER_TRIM sample spacings past the last samples (see `trim_border`).
         stats.trimmed_triangles = if params.trim > 0.0 {
-            trim_far_faces(&mut mesh, &near, params.trim * grid.cell, &threads)
+            trim_far_faces(&mut mesh, &sample_index, params.trim * grid.cell, &threads)
         } else {
-            trim_border(&mut mesh, &near, BORDER_TRIM * spacing, &threads)
+            trim_border(&mut mesh, &sample_index, BORDER_TRIM * spacing, &threads)
         };
     }
     stats.seconds_trim = t3.elapsed().as_secs_f64();
@@ -622,32 +627,32 @@ fn drop_small_parts(mesh: &mut Mesh, smallest: f64) -> bool {
     true
 }
 
-/// The paper's implicit function ([`BaseMesh::Paper`]): within `tolerance` of the samples the
+/// The paper's implicit function ([`BaseMesh::Paper`]): within `planes_within` of the samples the
 /// blended T-node planes; farther out the winding number's side, pushed away from zero with the
-/// distance, the planes only allowed to push further that way; beyond `far` the side alone.
+/// distance, the planes only allowed to push further that way; beyond `side_only_beyond` the side alone.
 fn paper_function(
     p: Vec3,
-    near: &PointBvh,
+    sample_index: &PointBvh,
     blend: &implicit::PlaneBlend,
     winding: &winding::WindingNumber,
     inside_above: f32,
-    tolerance: f32,
-    far: f32,
+    planes_within: f32,
+    side_only_beyond: f32,
 ) -> f32 {
-    if near.any_within(p, tolerance) {
+    if sample_index.any_within(p, planes_within) {
         return blend.eval(p);
     }
     let side = if winding.at(p) > inside_above { -1.0 } else { 1.0 };
-    let d = near.distance_within(p, far);
-    let blended = if d <= far { blend.eval(p) } else { f32::MAX };
+    let d = sample_index.distance_within(p, side_only_beyond);
+    let blended = if d <= side_only_beyond { blend.eval(p) } else { f32::MAX };
     if blended == f32::MAX {
         side * f32::MAX
     } else if side > 0.0 {
         // Otherwise planes that run on past a thin part bulge into the outside, and a bulge
         // that meets another part adds a handle.
-        blended.max(0.0) + (d - tolerance)
+        blended.max(0.0) + (d - planes_within)
     } else {
-        blended.min(0.0) - (d - tolerance)
+        blended.min(0.0) - (d - planes_within)
     }
 }
 
