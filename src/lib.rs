@@ -15,7 +15,7 @@ pub mod knn;
 mod linalg;
 pub mod mesh;
 pub mod normals;
-mod polygonize;
+mod polygonise;
 pub mod progress;
 pub mod quadric;
 pub mod reconstruct;

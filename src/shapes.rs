@@ -6,7 +6,7 @@
 //! of threads.
 
 use crate::mesh::Mesh;
-use crate::polygonize;
+use crate::polygonise;
 use crate::rng::{stream_seed, Rng};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -330,7 +330,7 @@ pub fn implicit_mesh(f: impl Fn(Vec3) -> f32 + Sync, min: Vec3, max: Vec3, resol
                             continue;
                         }
                         bits |= 1 << (d - 1);
-                        let t = polygonize::crossing_fraction(fp, fq);
+                        let t = polygonise::crossing_fraction(fp, fq);
                         let a = grid_ref.point(i, j, k);
                         let b = grid_ref.point(i + di, j + dj, k + dk);
                         positions.push(a + (b - a) * t);
@@ -366,7 +366,7 @@ pub fn implicit_mesh(f: impl Fn(Vec3) -> f32 + Sync, min: Vec3, max: Vec3, resol
                     if inside.iter().all(|&x| x == inside[0]) {
                         continue;
                     }
-                    polygonize::cube_triangles(
+                    polygonise::cube_triangles(
                         &inside,
                         |lower, upper| {
                             let v = grid.vertex(base + grid.corner_offset(lower), upper ^ lower);

@@ -6,7 +6,7 @@
 //!    number ([`winding`]) decides the side and the distance to the nearest sample the value
 //!    ([`BaseMesh::Winding`]); the paper's blend of the T-nodes' planes ([`implicit`]) is
 //!    [`BaseMesh::Paper`]. Polygonise it on a grid as fine as the deepest T-node
-//!    ([`crate::polygonize`]), and cluster that mesh at the T-layer into the base mesh M0, one
+//!    ([`crate::polygonise`]), and cluster that mesh at the T-layer into the base mesh M0, one
 //!    vertex per T-node ([`base_mesh`]). Where the polygonised surface has handles, parts
 //!    thinner than the grid resolves are thickened and the thickened surface is kept if that
 //!    removes handles (see `THICKEN_CELLS`);
@@ -40,7 +40,7 @@ use crate::distance::{PointBvh, TriangleBvh};
 use crate::error::{shown, Error, Result};
 use crate::mesh::Mesh;
 use crate::normals::{self, NormalParams, NormalsReport, OrientReport};
-use crate::polygonize::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
+use crate::polygonise::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
 use crate::progress::{Progress, Threads};
 use crate::samples::SampleSet;
 use crate::topology;
