@@ -286,6 +286,18 @@ fn is_single_fan(v: u32, fan: &[u32], faces: &[[u32; 3]]) -> bool {
     degree.iter().all(|&d| d <= 2) && (1..link_vertices.len() as u32).all(|x| uf.find(x) == root)
 }
 
+/// Which of `vertex_count` vertices lie on an edge that only one of `triangles` has.
+pub fn border_vertices(triangles: &[[u32; 3]], vertex_count: usize) -> Vec<bool> {
+    let mut border = vec![false; vertex_count];
+    for run in sorted_half_edges(triangles).chunk_by(|a, b| a.key == b.key) {
+        if let [only] = run {
+            border[(only.key >> 32) as usize] = true;
+            border[(only.key & 0xFFFF_FFFF) as usize] = true;
+        }
+    }
+    border
+}
+
 /// The pairs of faces that share an edge (every pair on a non-manifold edge).
 pub fn adjacent_face_pairs(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
     let mut pairs = Vec::with_capacity(3 * triangles.len() / 2);
@@ -389,6 +401,20 @@ pub fn surface_area(mesh: &Mesh) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn border_vertices_are_those_of_the_edges_one_face_has() {
+        let sphere = crate::shapes::icosphere(1.0, 2);
+        assert!(!border_vertices(&sphere.triangles, sphere.positions.len()).contains(&true));
+        // A 4 x 4 grid of squares: the 16 vertices round its edge, not the 9 inside.
+        let grid = crate::shapes::square_grid(4);
+        let border = border_vertices(&grid.triangles, grid.positions.len());
+        assert_eq!(border.iter().filter(|&&b| b).count(), 16);
+        for (v, p) in grid.positions.iter().enumerate() {
+            let on_edge = [p.x, p.y].iter().any(|&c| c.abs() < 1e-6 || (c - 1.0).abs() < 1e-6);
+            assert_eq!(border[v], on_edge, "vertex {v} at {p}");
+        }
+    }
 
     #[test]
     fn folded_face_pairs_are_the_pairs_turned_back_over_their_edge() {

@@ -552,7 +552,7 @@ pub fn reconstruct(
         let first_new = surface.positions.len();
         let (refined, level_stats) = refiner.refine(&surface, &threads);
         surface = refined;
-        let border = relax::border_vertices(&surface.triangles, surface.positions.len());
+        let border = topology::border_vertices(&surface.triangles, surface.positions.len());
         relax::relax_level(&mut surface, first_new, &border, &threads);
         mls::project_vertices(&mut surface, first_new, &onto_samples, mls_reach, &threads);
         mls::unfold(&mut surface, &border, &onto_samples, mls_reach, &threads);
@@ -830,7 +830,7 @@ fn trim_border(mesh: &mut Mesh, samples: &PointBvh, distance: f32, threads: &Thr
     let kept = remove_faces(mesh, &cut);
     let removed = before - mesh.triangles.len();
     let vertex_near: Vec<bool> = kept.iter().map(|&v| vertex_near[v]).collect();
-    let border = relax::border_vertices(&mesh.triangles, mesh.positions.len());
+    let border = topology::border_vertices(&mesh.triangles, mesh.positions.len());
     let neighbours = adjacency::Rows::neighbours(&mesh.triangles, mesh.positions.len());
     let moved: Vec<(usize, Vec3)> = threads.run(|| {
         (0..mesh.positions.len())

@@ -247,7 +247,7 @@ impl<'t> Refiner<'t> {
     /// it there would pull the border inward (a whole region of a large flat T-node when its
     /// corner folds).
     pub fn unfold_base(&self, s: &mut Surface) {
-        self.unfold(s, 0, &super::relax::border_vertices(&s.triangles, s.positions.len()));
+        self.unfold(s, 0, &crate::topology::border_vertices(&s.triangles, s.positions.len()));
     }
 
     /// [`Refiner::unfold_base`] for the vertices from `first` on that `border` does not mark

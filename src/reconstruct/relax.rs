@@ -33,7 +33,7 @@ const RELAX_STEP: f32 = 0.5;
 /// Flips and relaxes `s` (see the module), projecting moved vertices back onto `onto` within
 /// `reach`.
 pub(crate) fn improve(s: &mut Surface, onto: &SampleSurface, reach: f32, threads: &Threads) {
-    let border = border_vertices(&s.triangles, s.positions.len());
+    let border = crate::topology::border_vertices(&s.triangles, s.positions.len());
     for _ in 0..ROUNDS {
         flip_edges(s);
         relax(s, &border, threads);
@@ -44,32 +44,13 @@ pub(crate) fn improve(s: &mut Surface, onto: &SampleSurface, reach: f32, threads
 /// After a refinement level: [`LEVEL_ROUNDS`] tangential relaxations of the vertices from
 /// `first` on (the level's new ones), before they are projected onto the samples. The 1-to-4
 /// split keeps M0's shapes, but displacement moves a new vertex to its leaf's average sample,
-/// anywhere in the leaf, which skews the triangles around it. `border`: [`border_vertices`].
+/// anywhere in the leaf, which skews the triangles around it. `border`: [`crate::topology::border_vertices`].
 pub(crate) fn relax_level(s: &mut Surface, first: usize, border: &[bool], threads: &Threads) {
     let mut fixed = border.to_vec();
     fixed[..first].fill(true);
     for _ in 0..LEVEL_ROUNDS {
         relax(s, &fixed, threads);
     }
-}
-
-/// Vertices on an edge that only one triangle has.
-pub(crate) fn border_vertices(triangles: &[[u32; 3]], vertices: usize) -> Vec<bool> {
-    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-    }
-    let mut border = vec![false; vertices];
-    for (&(a, b), &n) in &edges {
-        if n == 1 {
-            border[a as usize] = true;
-            border[b as usize] = true;
-        }
-    }
-    border
 }
 
 /// The angle at `c` in triangle (a, b, c), in radians.
@@ -262,7 +243,7 @@ mod tests {
             triangles: fine.triangles.clone(),
         };
         let before = thin_share(&s, 20.0);
-        let border = border_vertices(&s.triangles, s.positions.len());
+        let border = crate::topology::border_vertices(&s.triangles, s.positions.len());
         relax_level(&mut s, first, &border, &Threads::new(1).unwrap());
         let after = thin_share(&s, 20.0);
         assert!(before > 0.08 && after < 0.03, "under 20 degrees: {before} -> {after}");
