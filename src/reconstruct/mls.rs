@@ -282,11 +282,9 @@ pub(crate) mod tests {
         assert!(p.z.abs() < 1e-5, "{p}");
     }
 
-    #[test]
-    fn a_vertex_pushed_over_its_neighbours_is_unfolded_back_onto_the_sphere() {
-        // An icosphere on sphere samples; three vertices slid along the sphere past their
-        // whole ring, so triangles around them face inward. Unfolding leaves none folded and
-        // every vertex on the sphere.
+    /// An icosphere on sphere samples with three vertices slid along the sphere past their
+    /// whole ring, so triangles around them face inward; normals radial.
+    fn pushed_icosphere() -> Surface {
         let sphere = crate::shapes::icosphere(1.0, 3);
         let mut s = Surface {
             normals: sphere.positions.clone(),
@@ -299,14 +297,27 @@ pub(crate) mod tests {
             let (u, _) = p.any_orthonormal_pair();
             s.positions[v] = (p + 0.4 * u).normalize();
         }
-        assert!(folded_vertices(&s).len() >= 9, "the push folds triangles");
+        s
+    }
+
+    /// Unfolds `s` onto samples of the unit sphere; returns the largest distance of a vertex
+    /// from the sphere.
+    fn unfold_onto_the_sphere(s: &mut Surface) -> f32 {
         let threads = Threads::new(1).unwrap();
         let samples = sphere_samples(20_000, 1.0);
         let onto = SampleSurface::new(&samples, &threads).unwrap();
         let border = vec![false; s.positions.len()];
-        unfold(&mut s, &border, &onto, 0.2, &threads);
+        unfold(s, &border, &onto, 0.2, &threads);
+        s.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max)
+    }
+
+    #[test]
+    fn a_vertex_pushed_over_its_neighbours_is_unfolded_back_onto_the_sphere() {
+        // Unfolding leaves no triangle folded and every vertex on the sphere.
+        let mut s = pushed_icosphere();
+        assert!(folded_vertices(&s).len() >= 9, "the push folds triangles");
+        let off = unfold_onto_the_sphere(&mut s);
         assert!(folded_vertices(&s).is_empty(), "still folded: {:?}", folded_vertices(&s));
-        let off = s.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max);
         assert!(off < 1e-3, "a vertex {off} off the sphere");
     }
 
@@ -314,18 +325,7 @@ pub(crate) mod tests {
     fn a_fold_whose_corner_normals_turned_with_it_is_unfolded_too() {
         // As above, but every vertex's normal is its faces' mean, as a fit's normal turns with a
         // fold: the corners' normals no longer tell the folded triangles, their dihedral angles do.
-        let sphere = crate::shapes::icosphere(1.0, 3);
-        let mut s = Surface {
-            normals: sphere.positions.clone(),
-            labels: vec![0; sphere.positions.len()],
-            positions: sphere.positions.clone(),
-            triangles: sphere.triangles.clone(),
-        };
-        for v in [10, 200, 400] {
-            let p = s.positions[v];
-            let (u, _) = p.any_orthonormal_pair();
-            s.positions[v] = (p + 0.4 * u).normalize();
-        }
+        let mut s = pushed_icosphere();
         let mut normals = vec![Vec3::ZERO; s.positions.len()];
         for t in &s.triangles {
             let [a, b, c] = t.map(|v| s.positions[v as usize]);
@@ -334,14 +334,9 @@ pub(crate) mod tests {
             }
         }
         s.normals = normals.into_iter().map(Vec3::normalize_or_zero).collect();
-        let threads = Threads::new(1).unwrap();
-        let samples = sphere_samples(20_000, 1.0);
-        let onto = SampleSurface::new(&samples, &threads).unwrap();
-        let border = vec![false; s.positions.len()];
-        unfold(&mut s, &border, &onto, 0.2, &threads);
+        let off = unfold_onto_the_sphere(&mut s);
         let left = folded_or_creased_vertices(&s, &crate::topology::adjacent_face_pairs(&s.triangles));
         assert!(left.is_empty(), "still folded: {left:?}");
-        let off = s.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max);
         assert!(off < 1e-3, "a vertex {off} off the sphere");
     }
 }
