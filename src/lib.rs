@@ -11,7 +11,6 @@ pub mod distance;
 pub mod error;
 pub mod ffi;
 pub mod io;
-pub mod knn;
 mod linalg;
 pub mod mesh;
 pub mod normals;
@@ -23,6 +22,7 @@ pub mod rng;
 pub mod samples;
 pub mod shapes;
 pub mod simplify;
+pub mod spatial;
 pub mod topology;
 pub mod tree;
 

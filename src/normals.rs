@@ -2,7 +2,7 @@
 //! they are not.
 //!
 //! **Estimation.** Each point's normal is the direction of least spread of its neighbourhood
-//! (the point and its `k` nearest other points, from an exact k-d tree, [`crate::knn`]): the
+//! (the point and its `k` nearest other points, from an exact k-d tree, [`crate::spatial::KdTree`]): the
 //! eigenvector of the smallest eigenvalue of the neighbourhood's 3x3 covariance, in `f64`. Its
 //! sign is arbitrary.
 //!
@@ -20,10 +20,10 @@
 //! linear-time bucket sort), and every result is the same for any thread count.
 
 use crate::error::{Error, Result};
-use crate::knn::KdTree;
 use crate::linalg::Sym3;
 use crate::mesh::{check_positions, Mesh};
 use crate::progress::{Progress, Threads};
+use crate::spatial::KdTree;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 

@@ -258,7 +258,7 @@ fn progress_is_reported_and_cancellation_stops() {
 /// For each point, whether its normal agrees in sign with most of its 8 nearest neighbours'.
 fn locally_consistent(points: &[Vec3], normals: &[Vec3]) -> f64 {
     let k = 8;
-    let rows = vstree::knn::knn_all(points, k).unwrap();
+    let rows = vstree::spatial::knn_all(points, k).unwrap();
     let good = (0..points.len())
         .filter(|&i| {
             let row = &rows[i * k..][..k];
@@ -415,7 +415,7 @@ fn merged_bunny_scans_match_the_reconstructed_mesh() {
     };
     // Truth: the normal of the nearest vertex of the mesh reconstructed from these scans.
     let samples = vstree::SampleSet::from_mesh(&mesh, vstree::MeshSampling::Vertices).unwrap();
-    let tree = vstree::knn::KdTree::new(&samples.positions).unwrap();
+    let tree = vstree::spatial::KdTree::new(&samples.positions).unwrap();
     let truth: Vec<Vec3> = scans.positions.iter().map(|p| samples.normals[tree.knn(*p, 1)[0].index as usize]).collect();
     let mut cloud = Mesh::from_points(scans.positions.clone(), None);
     let report = ensure_normals(&mut cloud, &NormalParams::default(), &mut Progress::none()).unwrap();

@@ -4,9 +4,9 @@
 
 use glam::Vec3;
 use std::time::Instant;
-use vstree::knn::KdTree;
 use vstree::normals::{estimate_normals, NormalParams};
 use vstree::shapes::{bumpy_sphere, sample_surface};
+use vstree::spatial::KdTree;
 use vstree::{Progress, Threads};
 
 const SIZES: [usize; 2] = [1_000_000, 5_000_000];

@@ -328,7 +328,7 @@ fn hemisphere_mesh() -> Mesh {
 
 /// The median distance from a point to its nearest other point.
 fn spacing(points: &[Vec3]) -> f32 {
-    let bvh = vstree::distance::PointBvh::new(points);
+    let bvh = vstree::spatial::KdTree::new(points).unwrap();
     let mut gaps: Vec<f32> = (0..points.len())
         .step_by(7)
         .filter_map(|i| bvh.nearest_among(points[i], |j| j as usize != i).map(|(d, _)| d))

@@ -3,9 +3,10 @@
 
 use glam::Vec3;
 use std::time::Instant;
-use vstree::distance::{point_to_mesh_distances, point_to_points_distances, PointBvh, TriangleBvh};
+use vstree::distance::{point_to_mesh_distances, point_to_points_distances};
 use vstree::rng::Rng;
 use vstree::shapes::{add_noise, genus_n_pretzel, icosphere, sample_surface, torus};
+use vstree::spatial::{KdTree, TriangleBvh};
 use vstree::topology::analyze;
 
 fn timed<T>(label: &str, f: impl FnOnce() -> T) -> T {
@@ -43,7 +44,7 @@ fn timings() {
     });
     assert!(d.iter().all(|x| x.is_finite()));
 
-    let points = timed("PointBvh::new 1M points", || PointBvh::new(&cloud.positions[..1_000_000]));
+    let points = timed("KdTree::new 1M points", || KdTree::new(&cloud.positions[..1_000_000]).unwrap());
     assert_eq!(points.len(), 1_000_000);
     let d = timed("point_to_points_distances 1M queries vs 1M points", || {
         point_to_points_distances(&noisy.positions, &cloud.positions[..1_000_000])

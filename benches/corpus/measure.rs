@@ -7,7 +7,8 @@ use crate::common::reconstruction::smallest_angle;
 use crate::inputs::Truth;
 use glam::Vec3;
 use rayon::prelude::*;
-use vstree::distance::{PointBvh, Target};
+use vstree::distance::Target;
+use vstree::spatial::KdTree;
 use vstree::{topology, Mesh};
 
 /// Adjacent faces whose normals differ by more than this many degrees make a fold.
@@ -53,14 +54,14 @@ impl Quality {
 
 /// The samples of an input, for the open inputs' figure.
 pub struct Samples {
-    bvh: PointBvh,
+    bvh: KdTree,
     /// Median nearest-neighbour distance.
     pub spacing: f32,
 }
 
 impl Samples {
     pub fn new(points: &[Vec3]) -> Samples {
-        let bvh = PointBvh::new(points);
+        let bvh = KdTree::new(points).expect("the input passed the reconstruction's checks");
         let step = (points.len() / SPACING_SAMPLES).max(1);
         let mut gaps: Vec<f64> = (0..points.len())
             .into_par_iter()

@@ -11,8 +11,8 @@
 use super::adjacency::Rows;
 use super::leaf_fit::solve;
 use super::refine::{folded_or_creased_vertices, folded_vertices, Surface};
-use crate::knn::KdTree;
 use crate::progress::Threads;
+use crate::spatial::KdTree;
 use crate::tree::TreeSample;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;

@@ -36,13 +36,13 @@ mod winding;
 pub use refine::LevelStats;
 pub use support::Closure;
 
-use crate::distance::{PointBvh, TriangleBvh};
 use crate::error::{shown, Error, Result};
 use crate::mesh::Mesh;
 use crate::normals::{self, NormalParams, NormalsReport, OrientReport};
 use crate::polygonise::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
 use crate::progress::{Progress, Threads};
 use crate::samples::SampleSet;
+use crate::spatial::{KdTree, TriangleBvh};
 use crate::topology;
 use crate::tree::{self, NodeKind, TreeKind, TreeParams, TreeSample, TreeStats, VsTree};
 use glam::Vec3;
@@ -380,7 +380,7 @@ pub fn reconstruct(
     let measured = evenly_spread(&samples.positions, ERROR_SAMPLES);
     drop(samples);
     let tree_order: Vec<Vec3> = tree.samples.iter().map(|s| s.position).collect();
-    let sample_index = threads.run(|| PointBvh::new(&tree_order));
+    let sample_index = threads.run(|| KdTree::new(&tree_order))?;
     let spacing = sample_spacing(&sample_index, &tree_order);
     let grid = polygonisation_grid(&tree, params.max_grid_depth, spacing);
     stats.grid_cells = grid.dims[0] - 5;
@@ -632,7 +632,7 @@ fn drop_small_parts(mesh: &mut Mesh, smallest: f64) -> bool {
 /// distance, the planes only allowed to push further that way; beyond `side_only_beyond` the side alone.
 fn paper_function(
     p: Vec3,
-    sample_index: &PointBvh,
+    sample_index: &KdTree,
     blend: &implicit::PlaneBlend,
     winding: &winding::WindingNumber,
     inside_above: f32,
@@ -738,7 +738,7 @@ fn median(mut values: Vec<f32>) -> f32 {
 /// The typical distance between neighbouring samples: the median, over up to 2,000 of the odd
 /// points, of the distance to the nearest even point at another place (`near` holds `points`;
 /// duplicate points would make it 0).
-fn sample_spacing(near: &PointBvh, points: &[Vec3]) -> f32 {
+fn sample_spacing(near: &KdTree, points: &[Vec3]) -> f32 {
     let odd: Vec<Vec3> = points.iter().skip(1).step_by(2).copied().collect();
     median(
         evenly_spread(&odd, 2000)
@@ -798,7 +798,7 @@ pub(super) fn renumber_used_vertices(triangles: &mut [[u32; 3]], vertices: usize
 }
 
 /// Removes the faces whose centroid is farther than `distance` from every sample; how many.
-fn trim_far_faces(mesh: &mut Mesh, samples: &PointBvh, distance: f32, threads: &Threads) -> usize {
+fn trim_far_faces(mesh: &mut Mesh, samples: &KdTree, distance: f32, threads: &Threads) -> usize {
     let far: Vec<bool> = threads.run(|| {
         mesh.triangles
             .par_iter()
@@ -820,7 +820,7 @@ fn trim_far_faces(mesh: &mut Mesh, samples: &PointBvh, distance: f32, threads: &
 /// would be wrong); then each border corner still farther slides along the surface towards
 /// its near neighbours until it is `distance` away. Removing faces alone leaves the border
 /// ragged by a face's size, which is many sample spacings on a smooth, densely sampled part.
-fn trim_border(mesh: &mut Mesh, samples: &PointBvh, distance: f32, threads: &Threads) -> usize {
+fn trim_border(mesh: &mut Mesh, samples: &KdTree, distance: f32, threads: &Threads) -> usize {
     let near = |p: Vec3| samples.any_within(p, distance);
     let vertex_near: Vec<bool> = threads.run(|| mesh.positions.par_iter().map(|&p| near(p)).collect());
     let far: Vec<bool> = mesh.triangles.iter().map(|t| t.iter().all(|&v| !vertex_near[v as usize])).collect();
@@ -890,7 +890,7 @@ mod tests {
         let mut mesh = crate::shapes::square_grid(10);
         let samples: Vec<Vec3> =
             (0..=43).flat_map(|i| (0..=100).map(move |j| Vec3::new(i as f32 * 0.01, j as f32 * 0.01, 0.0))).collect();
-        let near = PointBvh::new(&samples);
+        let near = KdTree::new(&samples).unwrap();
         let removed = trim_border(&mut mesh, &near, 0.02, &Threads::new(1).unwrap());
         assert_eq!(removed, 100, "the five columns of faces wholly past 0.45");
         let right = mesh.positions.iter().map(|p| p.x).fold(0.0f32, f32::max);
@@ -910,7 +910,7 @@ mod tests {
                 [p, p]
             })
             .collect();
-        let near = PointBvh::new(&points);
+        let near = KdTree::new(&points).unwrap();
         assert!((sample_spacing(&near, &points) - 0.01).abs() < 1e-6, "{}", sample_spacing(&near, &points));
     }
 }

@@ -7,9 +7,9 @@
 //! object whose scan has holes (a few percent), whatever the shape.
 
 use super::adjacency::Rows;
-use crate::distance::PointBvh;
 use crate::mesh::Mesh;
 use crate::progress::Threads;
+use crate::spatial::KdTree;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -65,7 +65,7 @@ pub(super) enum Support {
 /// area-weighted normals (the polygonisation's own faces are often slivers).
 pub(super) fn supported_faces(
     mesh: &Mesh,
-    samples: &PointBvh,
+    samples: &KdTree,
     normals: &[Vec3],
     reach: impl Fn(usize) -> f32 + Sync,
     threads: &Threads,
@@ -185,7 +185,7 @@ mod tests {
         let sphere = icosphere(1.0, 4);
         let upper: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z > 0.0).collect();
         let threads = Threads::new(1).unwrap();
-        let support = supported_faces(&sphere, &PointBvh::new(&upper), &upper, |_| 0.05, &threads);
+        let support = supported_faces(&sphere, &KdTree::new(&upper).unwrap(), &upper, |_| 0.05, &threads);
         let unsupported: Vec<bool> = support.iter().map(|&s| s == Support::Far).collect();
         let share = unsupported_share(&sphere, &unsupported);
         assert!((share - 0.5).abs() < 0.05, "{share}");
@@ -199,7 +199,7 @@ mod tests {
         let sphere = icosphere(1.0, 4);
         let kept: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z <= 0.9).collect();
         let threads = Threads::new(1).unwrap();
-        let support = supported_faces(&sphere, &PointBvh::new(&kept), &kept, |_| 0.05, &threads);
+        let support = supported_faces(&sphere, &KdTree::new(&kept).unwrap(), &kept, |_| 0.05, &threads);
         let unsupported: Vec<bool> = support.iter().map(|&s| s == Support::Far).collect();
         let share = unsupported_share(&sphere, &unsupported);
         assert!(share > 0.02 && share < 0.08, "{share}");
@@ -215,7 +215,7 @@ mod tests {
         let threads = Threads::new(1).unwrap();
         for (top, open) in [(0.5, false), (0.0, true)] {
             let kept: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z <= top).collect();
-            let support = supported_faces(&sphere, &PointBvh::new(&kept), &kept, |_| 0.05, &threads);
+            let support = supported_faces(&sphere, &KdTree::new(&kept).unwrap(), &kept, |_| 0.05, &threads);
             let unsupported: Vec<bool> = support.iter().map(|&s| s != Support::Supported).collect();
             let share = unsupported_share(&sphere, &unsupported);
             assert_eq!(is_open(Closure::default(), share), open, "{share} unsupported");
@@ -229,7 +229,7 @@ mod tests {
         let upper: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z > 0.0).collect();
         let down: Vec<Vec3> = upper.iter().map(|_| -Vec3::Z).collect();
         let threads = Threads::new(1).unwrap();
-        let support = supported_faces(&sphere, &PointBvh::new(&upper), &down, |_| 0.2, &threads);
+        let support = supported_faces(&sphere, &KdTree::new(&upper).unwrap(), &down, |_| 0.2, &threads);
         let centre = |t: &[u32; 3]| t.iter().map(|&v| sphere.positions[v as usize]).sum::<Vec3>() / 3.0;
         for (t, s) in sphere.triangles.iter().zip(&support) {
             let z = centre(t).z;

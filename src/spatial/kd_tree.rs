@@ -1,4 +1,7 @@
-//! Exact k-nearest-neighbour queries over a point set: a balanced k-d tree in flat arrays.
+//! The point index: a balanced k-d tree in flat arrays for exact nearest-neighbour queries, the
+//! k nearest ([`KdTree::knn`], [`KdTree::knn_all`]) or the nearest one, optionally among the
+//! points a filter keeps and within a radius ([`KdTree::nearest`], [`KdTree::any_within`],
+//! [`KdTree::distance_within`]).
 //!
 //! The tree is implicit: node `i` has children `2i + 1` and `2i + 2`, a node's points are a
 //! contiguous range of one array, and each split halves its range (`mid = begin + len / 2`), so
@@ -9,7 +12,8 @@
 //!
 //! Queries are exact in `f32`: neighbours are ordered by squared distance (computed as
 //! `dx*dx + dy*dy + dz*dz`, left to right), ties broken by the smaller input index, which is
-//! what a brute-force scan with the same ordering returns.
+//! what a brute-force scan with the same ordering returns. Distances a query returns are the
+//! square roots of those.
 
 use crate::error::{Error, Result};
 use crate::mesh::check_positions;
@@ -146,6 +150,27 @@ impl Best {
     }
 }
 
+/// Bounded searches look a little beyond their radius, so that rounding in the squared
+/// distances cannot change an answer against the unsquared one.
+const PRUNE_MARGIN: f32 = 1.0 + 1e-4;
+
+/// The nearest point found so far by a single-nearest search, among those it keeps.
+struct Nearest {
+    /// Squared distance of `id`, or the exclusive bound while nothing is found.
+    d2: f32,
+    id: Option<u32>,
+    /// A point this close (squared) ends the search.
+    enough: f32,
+}
+
+impl Nearest {
+    /// Whether a point at `d2` with index `id` beats the best so far (ties: smaller index).
+    #[inline(always)]
+    fn beaten_by(&self, d2: f32, id: u32) -> bool {
+        d2 < self.d2 || (d2 == self.d2 && self.id.is_some_and(|best| id < best))
+    }
+}
+
 impl KdTree {
     /// Builds the tree over `points` (in parallel on the current rayon pool).
     ///
@@ -186,6 +211,54 @@ impl KdTree {
     /// True when the tree holds no points.
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
+    }
+
+    /// The nearest point to `p` as (distance, index in the input slice), ties broken by the
+    /// smaller index; `None` when the tree is empty or `p` is not finite.
+    pub fn nearest(&self, p: Vec3) -> Option<(f32, u32)> {
+        self.nearest_among(p, |_| true)
+    }
+
+    /// The nearest point to `p` among those whose input index passes `keep`, as
+    /// [`KdTree::nearest`] gives it.
+    pub fn nearest_among(&self, p: Vec3, keep: impl Fn(u32) -> bool) -> Option<(f32, u32)> {
+        self.search_nearest(p, f32::INFINITY, f32::NEG_INFINITY, &keep).map(|(d2, id)| (d2.sqrt(), id))
+    }
+
+    /// Whether the nearest point is within `radius` of `p` (`distance(p) <= radius`, to the
+    /// bit); the search stops at the first point found well inside and skips everything
+    /// farther than `radius`, so it costs less than [`KdTree::distance`].
+    pub fn any_within(&self, p: Vec3, radius: f32) -> bool {
+        self.any_within_among(p, radius, |_| true)
+    }
+
+    /// Whether a point whose input index passes `keep` lies within `radius` of `p`; like
+    /// [`KdTree::any_within`], it skips everything farther than `radius`.
+    pub fn any_within_among(&self, p: Vec3, radius: f32, keep: impl Fn(u32) -> bool) -> bool {
+        let (below, enough) = ((radius * PRUNE_MARGIN).powi(2), (radius / PRUNE_MARGIN).powi(2));
+        self.search_nearest(p, below, enough, &keep).is_some_and(|(d2, _)| d2.sqrt() <= radius)
+    }
+
+    /// `distance(p)` when that is at most `cap`, else `f32::INFINITY`: the search skips
+    /// everything farther than `cap`. NaN when `p` has a NaN coordinate.
+    pub fn distance_within(&self, p: Vec3, cap: f32) -> f32 {
+        if p.is_nan() {
+            return f32::NAN;
+        }
+        match self.search_nearest(p, (cap * PRUNE_MARGIN).powi(2), f32::NEG_INFINITY, &|_| true) {
+            Some((d2, _)) if d2.sqrt() <= cap => d2.sqrt(),
+            _ => f32::INFINITY,
+        }
+    }
+
+    /// Distance from `p` to the nearest point: `f32::INFINITY` for an empty tree, NaN when `p`
+    /// has a NaN coordinate.
+    pub fn distance(&self, p: Vec3) -> f32 {
+        match self.nearest(p) {
+            Some((d, _)) => d,
+            None if p.is_nan() => f32::NAN,
+            None => f32::INFINITY,
+        }
     }
 
     /// The `k` points nearest to `p` (fewer when the tree has fewer), nearest first, ties
@@ -256,6 +329,43 @@ impl KdTree {
         });
     }
 
+    /// Checks what the queries rely on: the entries are a permutation of the input indices, there
+    /// are as many splits as [`inner_levels`] asks for, and every inner node's left half lies on
+    /// or below its split value and its right half on or above. The first broken rule, named,
+    /// as the error.
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.entries.len();
+        let mut seen = vec![false; n];
+        for e in &self.entries {
+            if e.id as usize >= n || std::mem::replace(&mut seen[e.id as usize], true) {
+                return Err(format!("the entries are not a permutation of 0..{n} (index {})", e.id));
+            }
+        }
+        let inner = (1usize << inner_levels(n)) - 1;
+        if self.splits.len() != inner {
+            return Err(format!("{} splits for {n} points (want {inner})", self.splits.len()));
+        }
+        let mut pending = vec![(0usize, 0usize, n)];
+        while let Some((node, begin, end)) = pending.pop() {
+            if node >= self.splits.len() {
+                continue;
+            }
+            let Split { value, axis } = self.splits[node];
+            if axis > 2 {
+                return Err(format!("node {node} splits along axis {axis}"));
+            }
+            let mid = begin + (end - begin) / 2;
+            let side = |range: std::ops::Range<usize>, on_side: &dyn Fn(f32) -> bool| {
+                self.entries[range].iter().all(|e| on_side(e.p[axis as usize]))
+            };
+            if !side(begin..mid, &|x| x <= value) || !side(mid..end, &|x| x >= value) {
+                return Err(format!("node {node}: a point is on the wrong side of {value} along axis {axis}"));
+            }
+            pending.extend([(2 * node + 1, begin, mid), (2 * node + 2, mid, end)]);
+        }
+        Ok(())
+    }
+
     /// The point at tree position `position`.
     pub(crate) fn point(&self, position: usize) -> Vec3 {
         Vec3::from_array(self.entries[position].p)
@@ -264,6 +374,60 @@ impl KdTree {
     /// The input index of the point at tree position `position`.
     pub(crate) fn index(&self, position: usize) -> u32 {
         self.entries[position].id
+    }
+
+    /// The nearest kept point closer than `below` (squared), as (squared distance, input
+    /// index), stopping at the first kept point within `enough` (squared).
+    fn search_nearest(&self, p: Vec3, below: f32, enough: f32, keep: &impl Fn(u32) -> bool) -> Option<(f32, u32)> {
+        if !p.is_finite() {
+            return None;
+        }
+        let mut best = Nearest { d2: below, id: None, enough };
+        self.visit_nearest(0, 0, self.entries.len(), p.to_array(), [0.0; 3], keep, &mut best);
+        best.id.map(|id| (best.d2, id))
+    }
+
+    /// [`KdTree::visit`] for a single nearest point; true once a point within `best.enough`
+    /// is found, which ends the search.
+    #[allow(clippy::too_many_arguments)]
+    fn visit_nearest(
+        &self,
+        node: usize,
+        begin: usize,
+        end: usize,
+        q: [f32; 3],
+        offset: [f32; 3],
+        keep: &impl Fn(u32) -> bool,
+        best: &mut Nearest,
+    ) -> bool {
+        if node >= self.splits.len() {
+            for e in &self.entries[begin..end] {
+                let d2 = dist2(q, e.p);
+                if best.beaten_by(d2, e.id) && keep(e.id) {
+                    (best.d2, best.id) = (d2, Some(e.id));
+                    if d2 <= best.enough {
+                        return true;
+                    }
+                }
+            }
+            return false;
+        }
+        let Split { value, axis } = self.splits[node];
+        let axis = axis as usize;
+        let mid = begin + (end - begin) / 2;
+        let diff = q[axis] - value;
+        let (near, far) = if diff <= 0.0 {
+            ((2 * node + 1, begin, mid), (2 * node + 2, mid, end))
+        } else {
+            ((2 * node + 2, mid, end), (2 * node + 1, begin, mid))
+        };
+        if self.visit_nearest(near.0, near.1, near.2, q, offset, keep, best) {
+            return true;
+        }
+        let mut far_offset = offset;
+        far_offset[axis] = far_offset[axis].max(diff.abs());
+        let [x, y, z] = far_offset;
+        x * x + y * y + z * z <= best.d2 && self.visit_nearest(far.0, far.1, far.2, q, far_offset, keep, best)
     }
 
     /// Fills `best` with the nearest points to `q`, leaving out tree position `skip`.
@@ -377,6 +541,53 @@ mod tests {
         }
     }
 
+    /// Brute force for the single-nearest queries: (distance, index) of the nearest kept point.
+    fn nearest_oracle(points: &[Vec3], q: Vec3, keep: impl Fn(u32) -> bool) -> Option<(f32, u32)> {
+        oracle(points, q, points.len(), None).into_iter().find(|&(_, i)| keep(i)).map(|(d2, i)| (d2.sqrt(), i))
+    }
+
+    #[test]
+    fn nearest_queries_match_brute_force() {
+        for points in [random_points(3000, 4), tied_points()] {
+            let tree = KdTree::new(&points).unwrap();
+            tree.validate().unwrap();
+            let mut rng = Rng::new(10);
+            for _ in 0..300 {
+                let q = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 8.0 - 1.0;
+                let want = nearest_oracle(&points, q, |_| true);
+                assert_eq!(tree.nearest(q), want, "q {q}");
+                assert_eq!(tree.distance(q), want.unwrap().0);
+                let odd = |i: u32| i % 2 == 1;
+                assert_eq!(tree.nearest_among(q, odd), nearest_oracle(&points, q, odd), "q {q}");
+                let d_odd = nearest_oracle(&points, q, odd).unwrap().0;
+                for r in [0.01, 0.3, want.unwrap().0, d_odd, 2.0] {
+                    let d = want.unwrap().0;
+                    assert_eq!(tree.any_within(q, r), d <= r, "q {q} r {r}");
+                    assert_eq!(tree.any_within_among(q, r, odd), d_odd <= r, "q {q} r {r}");
+                    assert_eq!(tree.distance_within(q, r), if d <= r { d } else { f32::INFINITY }, "q {q} r {r}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn validate_names_each_broken_rule() {
+        let points = random_points(500, 5);
+        let good = KdTree::new(&points).unwrap();
+        good.validate().unwrap();
+        let broken = |change: &dyn Fn(&mut KdTree)| {
+            let mut tree = good.clone();
+            change(&mut tree);
+            tree.validate().unwrap_err()
+        };
+        assert!(broken(&|t| t.entries[1].id = t.entries[0].id).contains("permutation"));
+        assert!(broken(&|t| {
+            t.splits.pop();
+        })
+        .contains("splits"));
+        assert!(broken(&|t| t.entries.swap(0, 499)).contains("wrong side"));
+    }
+
     #[test]
     fn same_answer_for_any_thread_count() {
         let points = random_points(50_000, 3);
@@ -387,10 +598,16 @@ mod tests {
 
     #[test]
     fn small_and_bad_inputs() {
-        assert!(KdTree::new(&[]).unwrap().knn(Vec3::ZERO, 3).is_empty());
+        let empty = KdTree::new(&[]).unwrap();
+        assert!(empty.knn(Vec3::ZERO, 3).is_empty());
+        assert_eq!((empty.nearest(Vec3::ZERO), empty.distance(Vec3::ZERO)), (None, f32::INFINITY));
+        assert!(!empty.any_within(Vec3::ZERO, 1.0));
+        empty.validate().unwrap();
         let one = KdTree::new(&[Vec3::ONE]).unwrap();
         assert_eq!(one.knn(Vec3::ZERO, 3).len(), 1);
         assert!(one.knn(Vec3::NAN, 1).is_empty());
+        assert!(one.distance(Vec3::NAN).is_nan() && one.distance_within(Vec3::NAN, 1.0).is_nan());
+        assert_eq!(one.nearest(Vec3::INFINITY), None);
         assert!(one.knn_all(1).is_err());
         let same = vec![Vec3::splat(2.0); 20];
         let all = knn_all(&same, 3).unwrap();
