@@ -286,13 +286,29 @@ fn is_single_fan(v: u32, fan: &[u32], faces: &[[u32; 3]]) -> bool {
     degree.iter().all(|&d| d <= 2) && (1..link_vertices.len() as u32).all(|x| uf.find(x) == root)
 }
 
+/// Every edge of `triangles` once, as (low, high) vertex index, in sorted order, with the number
+/// of faces that have it (1 on a border, 2 inside a manifold).
+pub fn edges_and_face_counts(triangles: &[[u32; 3]]) -> Vec<((u32, u32), u32)> {
+    let mut keys: Vec<u64> = triangles
+        .par_iter()
+        .flat_map_iter(|t| {
+            (0..3).map(move |k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                u64::from(a.min(b)) << 32 | u64::from(a.max(b))
+            })
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys.chunk_by(|a, b| a == b).map(|run| (((run[0] >> 32) as u32, run[0] as u32), run.len() as u32)).collect()
+}
+
 /// Which of `vertex_count` vertices lie on an edge that only one of `triangles` has.
 pub fn border_vertices(triangles: &[[u32; 3]], vertex_count: usize) -> Vec<bool> {
     let mut border = vec![false; vertex_count];
-    for run in sorted_half_edges(triangles).chunk_by(|a, b| a.key == b.key) {
-        if let [only] = run {
-            border[(only.key >> 32) as usize] = true;
-            border[(only.key & 0xFFFF_FFFF) as usize] = true;
+    for ((a, b), faces) in edges_and_face_counts(triangles) {
+        if faces == 1 {
+            border[a as usize] = true;
+            border[b as usize] = true;
         }
     }
     border

@@ -98,16 +98,11 @@ impl<'t> Refiner<'t> {
 
     fn refine_level(&self, s: &Surface) -> (Surface, LevelStats) {
         let old = s.positions.len() as u32;
-        let mut edges: Vec<(u32, u32)> = s
-            .triangles
-            .par_iter()
-            .flat_map_iter(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
-            .collect();
-        edges.par_sort_unstable();
+        let (edges, face_counts): (Vec<(u32, u32)>, Vec<u32>) =
+            crate::topology::edges_and_face_counts(&s.triangles).into_iter().unzip();
         // A border edge (one face) gives a border vertex, which stays on its edge's curve:
         // sliding or smoothing it towards its neighbours would pull the border inward.
-        let on_border: Vec<bool> = edges.chunk_by(|a, b| a == b).map(|run| run.len() == 1).collect();
-        edges.dedup();
+        let on_border: Vec<bool> = face_counts.iter().map(|&faces| faces == 1).collect();
         let mid = |a: u32, b: u32| old + edges.binary_search(&(a.min(b), a.max(b))).unwrap_or(0) as u32;
 
         // New vertices on the PN triangles' edge curves, with PN's quadratic normals.
