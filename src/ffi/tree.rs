@@ -9,10 +9,8 @@ use super::simplify::{read_params, tree_figures, vstree_simplify_params};
 use super::{guard, guard_or, non_null, vstree_status, write_out, Failure, FfiResult};
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
-use crate::quadric::CellStats;
 use crate::simplify::{cluster_mesh, vertex_labels, Clustered, SimplifyParams, NO_CLUSTER};
-use crate::tree::{self, Metric, NodeKind, VsTree};
-use rayon::prelude::*;
+use crate::tree::NodeKind;
 use std::ffi::c_void;
 use std::time::Instant;
 
@@ -302,7 +300,7 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
         }
         level.leaves += u64::from(n.is_leaf());
     }
-    let errors = threads.run(|| cluster_errors(&tree, &clusters.leaves));
+    let errors = threads.run(|| tree.node_errors(&clusters.leaves));
     let max_error = errors.iter().copied().fold(0.0, f64::max);
     let mean_error = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
     progress.report(1.0, "done")?;
@@ -330,36 +328,6 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
         seconds_total: 0.0,
     };
     Ok(vstree_tree { stats, nodes, t_nodes, levels, cluster_labels, t_node_labels })
-}
-
-/// Each cluster's error: the figure the tree's split test compares with `error`.
-fn cluster_errors(tree: &VsTree, leaves: &[u32]) -> Vec<f64> {
-    let origin = tree.root().center.as_dvec3();
-    let scale = f64::from(tree.diagonal).powi(2);
-    leaves
-        .par_iter()
-        .map(|&leaf| {
-            let node = &tree.nodes[leaf as usize];
-            let mut stats = CellStats::default();
-            for s in tree.samples_of(node) {
-                stats.add(s.position.as_dvec3() - origin, s.normal.as_dvec3());
-            }
-            match tree.params.metric {
-                Metric::L2 => {
-                    let frame = (node.kind == NodeKind::Surface).then(|| &tree.frames[node.frame as usize]);
-                    let x = tree::representative(node, frame, &stats, origin);
-                    let absolute = stats.quadric_at(x - origin);
-                    if scale > 0.0 {
-                        absolute / scale
-                    } else {
-                        0.0
-                    }
-                }
-                Metric::L21 => stats.normal_deviation(),
-                Metric::Density => stats.count as f64,
-            }
-        })
-        .collect()
 }
 
 /// Frees a tree made by vstree_tree_build(). NULL is a no-op.
