@@ -12,10 +12,10 @@
 //! - a failing call leaves a message naming the function and the offending argument or field
 //!   in a thread-local buffer ([`vstree_last_error_message`]).
 //!
-//! One idea per file: [`arrays`] checks caller arrays, [`params`] reads versioned structs,
-//! [`progress`] adapts the C callback, [`version`] holds the version, [`mesh`], [`simplify`] and
-//! [`tree`] are the three handles; [`normals`] estimates normals into a new mesh, and
-//! [`reconstruct`] is the fourth handle.
+//! One idea per file: [`arrays`] checks caller arrays, [`handle`] boxes, borrows and frees
+//! handles, [`params`] reads versioned structs, [`progress`] adapts the C callback, [`version`]
+//! holds the version, [`mesh`], [`simplify`] and [`tree`] are the three handles; [`normals`]
+//! estimates normals into a new mesh, and [`reconstruct`] is the fourth handle.
 // The C names are the Rust names, so a symbol in the header can be grepped for here.
 #![allow(non_camel_case_types)]
 // Each function documents what its pointer arguments must be (a handle from a named call, or an
@@ -23,6 +23,7 @@
 #![allow(clippy::missing_safety_doc)]
 
 pub mod arrays;
+pub mod handle;
 pub mod mesh;
 pub mod params;
 pub mod progress;

@@ -1,10 +1,10 @@
 //! Clustering simplification: the parameter struct (shared with vstree_tree_build(), which
 //! builds the same tree), the call, and its result handle with the output mesh and statistics.
 
-use super::mesh::{into_handle, mesh_ref, vstree_mesh};
+use super::mesh::{mesh_ref, vstree_mesh};
 use super::params::{self, one_of, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
-use super::{guard, guard_or, non_null, vstree_status, write_out, FfiResult};
+use super::{guard, handle, non_null, vstree_status, write_out, FfiResult};
 use crate::samples::MeshSampling;
 use crate::simplify::{simplify, KeepTopology, SimplifyParams};
 use crate::tree::{Metric, TreeKind, TreeParams, TreeStats};
@@ -317,8 +317,8 @@ pub unsafe extern "C" fn vstree_simplify(
             kept_topology: u32::from(s.kept_topology),
             target_faces: params.target_faces as u32,
         };
-        let result = Box::new(vstree_simplify_result { mesh: vstree_mesh { mesh: out }, stats });
-        unsafe { write_out(out_result, Box::into_raw(result)) };
+        let result = vstree_simplify_result { mesh: vstree_mesh { mesh: out }, stats };
+        unsafe { write_out(out_result, handle::into_raw(result)) };
         Ok(())
     })
 }
@@ -328,11 +328,7 @@ pub unsafe extern "C" fn vstree_simplify(
 /// function (counts, copies, vstree_mesh_save(), even vstree_simplify() again). NULL for NULL.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_simplify_result_get_mesh(result: *const vstree_simplify_result) -> *const vstree_mesh {
-    guard_or(std::ptr::null(), || match result.is_null() {
-        true => std::ptr::null(),
-        // SAFETY: a live result from vstree_simplify(), by the caller's contract.
-        false => unsafe { &(*result).mesh as *const vstree_mesh },
-    })
+    unsafe { handle::part(result, |r| &r.mesh) }
 }
 
 /// The statistics of the simplification, owned by `result` (valid until it is freed; do not
@@ -341,22 +337,13 @@ pub unsafe extern "C" fn vstree_simplify_result_get_mesh(result: *const vstree_s
 pub unsafe extern "C" fn vstree_simplify_result_get_stats(
     result: *const vstree_simplify_result,
 ) -> *const vstree_simplify_stats {
-    guard_or(std::ptr::null(), || match result.is_null() {
-        true => std::ptr::null(),
-        // SAFETY: as above.
-        false => unsafe { &(*result).stats as *const vstree_simplify_stats },
-    })
+    unsafe { handle::part(result, |r| &r.stats) }
 }
 
 /// Frees a result of vstree_simplify() and the mesh and statistics it owns. NULL is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_simplify_result_free(result: *mut vstree_simplify_result) {
-    guard_or((), || {
-        if !result.is_null() {
-            // SAFETY: a result this library boxed; the caller gives up ownership.
-            drop(unsafe { Box::from_raw(result) });
-        }
-    })
+    unsafe { handle::free(result) }
 }
 
 /// Moves the mesh out of a simplification result into its own handle, for callers that want to
@@ -368,14 +355,7 @@ pub unsafe extern "C" fn vstree_simplify_result_take_mesh(
     result: *mut vstree_simplify_result,
     out_mesh: *mut *mut vstree_mesh,
 ) -> vstree_status {
-    guard("vstree_simplify_result_take_mesh", || {
-        non_null(out_mesh, "out_mesh")?;
-        let result = non_null(result, "result")?;
-        // SAFETY: a result this library boxed; the caller gives up ownership.
-        let result = unsafe { Box::from_raw(result.cast_mut()) };
-        unsafe { write_out(out_mesh, into_handle(result.mesh.mesh)) };
-        Ok(())
-    })
+    unsafe { handle::take_mesh("vstree_simplify_result_take_mesh", result, out_mesh, |r| r.mesh.mesh) }
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@ use super::arrays::copy_out;
 use super::mesh::{mesh_ref, vstree_mesh};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::simplify::{read_params, tree_figures, vstree_simplify_params};
-use super::{guard, guard_or, non_null, vstree_status, write_out, Failure, FfiResult};
+use super::{guard, guard_or, handle, non_null, vstree_status, write_out, Failure, FfiResult};
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
 use crate::simplify::{cluster_mesh, vertex_labels, Clustered, SimplifyParams, NO_CLUSTER};
@@ -201,7 +201,7 @@ pub unsafe extern "C" fn vstree_tree_build(
         let params = unsafe { read_params(params) }?;
         let mut tree = with_progress(progress, user_data, |p| build(mesh, &params, p))?;
         tree.stats.seconds_total = start.elapsed().as_secs_f64();
-        unsafe { write_out(out_tree, Box::into_raw(Box::new(tree))) };
+        unsafe { write_out(out_tree, handle::into_raw(tree)) };
         Ok(())
     })
 }
@@ -333,55 +333,40 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
 /// Frees a tree made by vstree_tree_build(). NULL is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_free(tree: *mut vstree_tree) {
-    guard_or((), || {
-        if !tree.is_null() {
-            // SAFETY: a tree this library boxed; the caller gives up ownership.
-            drop(unsafe { Box::from_raw(tree) });
-        }
-    })
-}
-
-/// Borrows the tree behind a handle, or `None` for NULL.
-unsafe fn tree_opt<'a>(tree: *const vstree_tree) -> Option<&'a vstree_tree> {
-    // SAFETY: NULL or a live handle, by the caller's contract.
-    unsafe { tree.as_ref() }
-}
-
-unsafe fn tree_ref<'a>(tree: *const vstree_tree) -> FfiResult<&'a vstree_tree> {
-    unsafe { tree_opt(tree) }.ok_or_else(|| Failure::null("tree"))
+    unsafe { handle::free(tree) }
 }
 
 /// The tree's statistics, owned by `tree` (valid until it is freed; do not free it). NULL for
 /// NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_get_stats(tree: *const vstree_tree) -> *const vstree_tree_stats {
-    guard_or(std::ptr::null(), || unsafe { tree_opt(tree) }.map_or(std::ptr::null(), |t| &t.stats as *const _))
+    unsafe { handle::part(tree, |t| &t.stats) }
 }
 
 /// Number of nodes (the length vstree_tree_copy_nodes() needs); 0 for NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_node_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.nodes.len()))
+    guard_or(0, || unsafe { handle::borrow_opt(tree) }.map_or(0, |t| t.nodes.len()))
 }
 
 /// Number of T-nodes (the length vstree_tree_copy_t_nodes() needs); 0 for NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_t_node_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.t_nodes.len()))
+    guard_or(0, || unsafe { handle::borrow_opt(tree) }.map_or(0, |t| t.t_nodes.len()))
 }
 
 /// Number of levels, max_depth + 1 (the length vstree_tree_copy_levels() needs); 0 for NULL.
 /// Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_level_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.levels.len()))
+    guard_or(0, || unsafe { handle::borrow_opt(tree) }.map_or(0, |t| t.levels.len()))
 }
 
 /// Number of labels: the vertex (point) count of the mesh the tree was built from (the length
 /// vstree_tree_copy_vertex_labels() needs); 0 for NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_vertex_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.cluster_labels.len()))
+    guard_or(0, || unsafe { handle::borrow_opt(tree) }.map_or(0, |t| t.cluster_labels.len()))
 }
 
 /// Copies every node into the caller's array `out` of `capacity` elements, which must be at
@@ -396,7 +381,7 @@ pub unsafe extern "C" fn vstree_tree_copy_nodes(
     capacity: usize,
 ) -> vstree_status {
     guard("vstree_tree_copy_nodes", || {
-        let tree = unsafe { tree_ref(tree) }?;
+        let tree = unsafe { handle::borrow(tree, "tree") }?;
         unsafe { copy_out(&tree.nodes, out, capacity, "out") }
     })
 }
@@ -413,7 +398,7 @@ pub unsafe extern "C" fn vstree_tree_copy_t_nodes(
     capacity: usize,
 ) -> vstree_status {
     guard("vstree_tree_copy_t_nodes", || {
-        let tree = unsafe { tree_ref(tree) }?;
+        let tree = unsafe { handle::borrow(tree, "tree") }?;
         unsafe { copy_out(&tree.t_nodes, out, capacity, "out") }
     })
 }
@@ -429,7 +414,7 @@ pub unsafe extern "C" fn vstree_tree_copy_levels(
     capacity: usize,
 ) -> vstree_status {
     guard("vstree_tree_copy_levels", || {
-        let tree = unsafe { tree_ref(tree) }?;
+        let tree = unsafe { handle::borrow(tree, "tree") }?;
         unsafe { copy_out(&tree.levels, out, capacity, "out") }
     })
 }
@@ -449,7 +434,7 @@ pub unsafe extern "C" fn vstree_tree_copy_vertex_labels(
     capacity: usize,
 ) -> vstree_status {
     guard("vstree_tree_copy_vertex_labels", || {
-        let tree = unsafe { tree_ref(tree) }?;
+        let tree = unsafe { handle::borrow(tree, "tree") }?;
         let labels = match kind {
             0 => &tree.cluster_labels,
             1 => &tree.t_node_labels,
