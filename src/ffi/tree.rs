@@ -4,6 +4,7 @@
 
 use super::arrays::copy_out;
 use super::mesh::{mesh_ref, vstree_mesh};
+use super::params::{c_enum, CEnum};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::simplify::{read_params, tree_figures, vstree_simplify_params};
 use super::{guard, guard_or, handle, non_null, vstree_status, write_out, Failure, FfiResult};
@@ -30,6 +31,20 @@ pub enum vstree_node_kind {
     /// A quadtree cell: a square in its T-node's plane, with up to 4 S-node children.
     Surface = 2,
 }
+c_enum!(vstree_node_kind {
+    Volume = "VSTREE_NODE_KIND_VOLUME",
+    Transition = "VSTREE_NODE_KIND_TRANSITION",
+    Surface = "VSTREE_NODE_KIND_SURFACE",
+});
+
+/// The C kind of a node.
+fn node_kind(kind: NodeKind) -> vstree_node_kind {
+    match kind {
+        NodeKind::Volume => vstree_node_kind::Volume,
+        NodeKind::Transition => vstree_node_kind::Transition,
+        NodeKind::Surface => vstree_node_kind::Surface,
+    }
+}
 
 /// What vstree_tree_copy_vertex_labels() gives per input vertex.
 #[repr(i32)]
@@ -41,6 +56,7 @@ pub enum vstree_label_kind {
     /// cluster, or VSTREE_NO_INDEX when the cluster is an octree leaf or there is none.
     TNode = 1,
 }
+c_enum!(vstree_label_kind { Cluster = "VSTREE_LABEL_KIND_CLUSTER", TNode = "VSTREE_LABEL_KIND_T_NODE" });
 
 /// One node of the tree, as vstree_tree_copy_nodes() gives them: node 0 is the root, and a
 /// node's children are contiguous.
@@ -244,7 +260,7 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
             parent: n.parent,
             first_child: n.first_child,
             child_count: n.child_count.into(),
-            kind: n.kind as i32,
+            kind: node_kind(n.kind).raw(),
             depth: n.depth.into(),
             sample_count: n.count,
             t_node: t_of(i),
@@ -435,10 +451,10 @@ pub unsafe extern "C" fn vstree_tree_copy_vertex_labels(
 ) -> vstree_status {
     guard("vstree_tree_copy_vertex_labels", || {
         let tree = unsafe { handle::borrow(tree, "tree") }?;
-        let labels = match kind {
-            0 => &tree.cluster_labels,
-            1 => &tree.t_node_labels,
-            _ => {
+        let labels = match vstree_label_kind::from_raw(kind) {
+            Some(vstree_label_kind::Cluster) => &tree.cluster_labels,
+            Some(vstree_label_kind::TNode) => &tree.t_node_labels,
+            None => {
                 return Err(Failure::argument(
                     "kind",
                     format!(
