@@ -5,11 +5,11 @@ use super::mesh::{mesh_ref, vstree_mesh};
 use super::normals::{flag, orientation, orientation_value, threads};
 use super::params::{self, one_of, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
-use super::{guard, handle, non_null, vstree_status, write_out, FfiResult};
+use super::{guard, guard_or, handle, non_null, vstree_status, write_out, FfiResult};
 use crate::normals::NormalParams;
 use crate::reconstruct::{reconstruct, BaseMesh, Closure, ReconstructParams, ReconstructStats, RefinementStop};
 use crate::tree::{Metric, TreeKind, TreeParams};
-use std::ffi::c_void;
+use std::ffi::{c_char, c_void};
 use std::mem::size_of;
 use std::time::Instant;
 
@@ -295,6 +295,11 @@ pub const VSTREE_REFINEMENT_STOPPED_MAX_LEVELS: u32 = 2;
 /// `stopped` value: the next level would have exceeded `max_triangles`; raise it or the target.
 pub const VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET: u32 = 3;
 
+/// The refinement stop a `stopped` value means, if it is one.
+fn refinement_stop(stopped: u32) -> Option<RefinementStop> {
+    RefinementStop::ALL.into_iter().find(|&stop| stopped_value(stop) == stopped)
+}
+
 /// The C value of a refinement stop.
 fn stopped_value(stop: RefinementStop) -> u32 {
     match stop {
@@ -428,6 +433,15 @@ pub unsafe extern "C" fn vstree_reconstruct_result_take_mesh(
     out_mesh: *mut *mut vstree_mesh,
 ) -> vstree_status {
     unsafe { handle::take_mesh("vstree_reconstruct_result_take_mesh", result, out_mesh, |r| r.mesh.mesh) }
+}
+
+/// The name of a `stopped` value of ::vstree_reconstruct_stats, the end of its
+/// VSTREE_REFINEMENT_STOPPED_ constant in lower case: "target", "no_detail", "max_levels" or
+/// "triangle_budget"; other numbers give "unknown". A static, NUL-terminated string: never NULL,
+/// never to be freed. Thread-safe. Since 0.4.0.
+#[no_mangle]
+pub extern "C" fn vstree_refinement_stopped_str(stopped: u32) -> *const c_char {
+    guard_or(c"unknown".as_ptr(), || refinement_stop(stopped).map_or(c"unknown", RefinementStop::as_c_str).as_ptr())
 }
 
 #[cfg(test)]
