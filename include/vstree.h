@@ -70,7 +70,7 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 3
+#define VSTREE_VERSION_MINOR 4
 
 /**
  * Patch version (semver).
@@ -1569,6 +1569,14 @@ void vstree_reconstruct_result_free(struct vstree_reconstruct_result *result);
  */
 vstree_status vstree_reconstruct_result_take_mesh(struct vstree_reconstruct_result *result,
                                                   struct vstree_mesh **out_mesh);
+
+/**
+ * The name of a `stopped` value of ::vstree_reconstruct_stats, the end of its
+ * VSTREE_REFINEMENT_STOPPED_ constant in lower case: "target", "no_detail", "max_levels" or
+ * "triangle_budget"; other numbers give "unknown". A static, NUL-terminated string: never NULL,
+ * never to be freed. Thread-safe. Since 0.4.0.
+ */
+const char *vstree_refinement_stopped_str(uint32_t stopped);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -3,7 +3,7 @@
 //! parameter refused by name, and bad input giving statuses. `tests/c` and `tests/python` test
 //! the same calls from the host languages.
 
-use std::ffi::{c_char, c_void};
+use std::ffi::{c_char, c_void, CStr};
 use std::ptr::{null, null_mut};
 use vstree::ffi::mesh::*;
 use vstree::ffi::normals::*;
@@ -32,6 +32,30 @@ fn quick() -> (vstree_reconstruct_params, ReconstructParams) {
     c.max_grid_depth = 7;
     let rust = ReconstructParams { max_levels: 2, max_grid_depth: 7, ..ReconstructParams::default() };
     (c, rust)
+}
+
+/// Every refinement stop with its C value.
+const STOPS: [(RefinementStop, u32); 4] = [
+    (RefinementStop::Target, VSTREE_REFINEMENT_STOPPED_TARGET),
+    (RefinementStop::NoDetail, VSTREE_REFINEMENT_STOPPED_NO_DETAIL),
+    (RefinementStop::MaxLevels, VSTREE_REFINEMENT_STOPPED_MAX_LEVELS),
+    (RefinementStop::TriangleBudget, VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET),
+];
+
+#[test]
+fn refinement_stops_are_named_as_the_rust_enum_names_them() {
+    let name = |value: u32| unsafe { CStr::from_ptr(vstree_refinement_stopped_str(value)) }.to_str().unwrap();
+    assert_eq!(STOPS.map(|(stop, _)| stop), RefinementStop::ALL);
+    for (stop, value) in STOPS {
+        assert_eq!(name(value), stop.as_str());
+    }
+    assert_eq!(
+        RefinementStop::ALL.map(RefinementStop::as_str),
+        ["target", "no_detail", "max_levels", "triangle_budget"]
+    );
+    for value in [4, 1000, u32::MAX] {
+        assert_eq!(name(value), "unknown");
+    }
 }
 
 #[test]
@@ -63,13 +87,7 @@ fn reconstruct_through_the_abi_equals_the_rust_call() {
         assert!(stats.final_max_error >= stats.final_error && stats.final_error < 1e-2);
         assert!(stats.seconds_total >= stats.seconds_tree);
         assert_eq!(stats.thickened, u32::from(s.thickened));
-        let stop = [
-            (RefinementStop::Target, VSTREE_REFINEMENT_STOPPED_TARGET),
-            (RefinementStop::NoDetail, VSTREE_REFINEMENT_STOPPED_NO_DETAIL),
-            (RefinementStop::MaxLevels, VSTREE_REFINEMENT_STOPPED_MAX_LEVELS),
-            (RefinementStop::TriangleBudget, VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET),
-        ];
-        assert!(stop.contains(&(s.stopped, stats.stopped)), "{:?} vs {}", s.stopped, stats.stopped);
+        assert!(STOPS.contains(&(s.stopped, stats.stopped)), "{:?} vs {}", s.stopped, stats.stopped);
         assert_eq!(topology::analyze(&out).genus(), Some(1));
 
         // take_mesh moves the same mesh out and frees the result.

@@ -265,18 +265,6 @@ void addTreeParams(RichParameterList& pl, const vstree_simplify_params& d, doubl
 	pl.addParam(RichInt("max_depth", int(d.max_depth), "Max depth", "Deepest tree level, in [1, 30]."));
 }
 
-// Why refinement stopped, for the log (vstree_reconstruct_stats::stopped).
-const char* refinementStop(uint32_t stopped)
-{
-	switch (stopped) {
-	case VSTREE_REFINEMENT_STOPPED_TARGET: return "target distance reached";
-	case VSTREE_REFINEMENT_STOPPED_NO_DETAIL: return "no detail left in the tree";
-	case VSTREE_REFINEMENT_STOPPED_MAX_LEVELS: return "level limit";
-	case VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET: return "triangle budget; raise the error bound";
-	default: return "unknown";
-	}
-}
-
 uint32_t hashColour(uint32_t x)
 {
 	x ^= x >> 16; x *= 0x7feb352dU; x ^= x >> 15; x *= 0x846ca68bU; x ^= x >> 16;
@@ -464,13 +452,14 @@ std::map<std::string, QVariant> FilterVstreePlugin::apply(
 		MeshModel* dst = md.addNewMesh("", src->label() + " (vstree reconstruction)", true);
 		fromVstree(vstree_reconstruct_result_get_mesh(res), dst->cm);
 		logf("VS-Tree reconstruction: %llu points -> %llu vertices, %llu triangles; base mesh %llu "
-			"triangles (genus %d%s), %u levels (stopped: %s), RMS error %.3g of the diagonal, %llu "
+			"triangles (genus %d%s), %u levels (stopped: %s%s), RMS error %.3g of the diagonal, %llu "
 			"normals estimated, %.3f s",
 			(unsigned long long)a.vertIndex.size(), (unsigned long long)s->output_vertices,
 			(unsigned long long)s->output_triangles, (unsigned long long)s->base_triangles,
 			s->base_genus, s->thickened ? ", thin parts thickened" : "", s->levels,
-			refinementStop(s->stopped), s->final_error, (unsigned long long)s->normals_estimated,
-			s->seconds_total);
+			vstree_refinement_stopped_str(s->stopped),
+			s->stopped == VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET ? "; raise the error bound" : "",
+			s->final_error, (unsigned long long)s->normals_estimated, s->seconds_total);
 		out["output_vertices"] = QVariant(int(s->output_vertices));
 		out["output_triangles"] = QVariant(int(s->output_triangles));
 		out["levels"] = QVariant(int(s->levels));

@@ -580,18 +580,12 @@ fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &Reconstruct
             level.displaced
         );
     }
-    let stopped = match s.stopped {
-        RefinementStop::Target => "the target distance was reached",
-        RefinementStop::NoDetail => "the quadtrees have no detail left for another level",
-        RefinementStop::MaxLevels => "the most levels (--levels) were done",
-        RefinementStop::TriangleBudget => {
-            eprintln!(
-                "warning: refinement stopped short of the target: another level would exceed the library's triangle budget"
-            );
-            "the triangle budget was reached"
-        }
-    };
-    println!("refinement stopped: {stopped}");
+    if s.stopped == RefinementStop::TriangleBudget {
+        eprintln!(
+            "warning: refinement stopped short of the target: another level would exceed the library's triangle budget"
+        );
+    }
+    println!("refinement stopped: {}", s.stopped.as_str());
     println!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
     let share = 100.0 * s.unsupported_share;
     if s.open {

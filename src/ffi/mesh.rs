@@ -2,7 +2,7 @@
 //! arrays or read from a file; its arrays are copied out into the caller's buffers.
 
 use super::arrays::{self, copy_out, elements, input};
-use super::{guard, guard_or, non_null, vstree_status, write_out, Failure, FfiResult};
+use super::{guard, guard_or, handle, non_null, vstree_status, write_out, Failure, FfiResult};
 use crate::io::{self, Format, WriteOptions};
 use crate::mesh::Mesh;
 use glam::Vec3;
@@ -27,16 +27,14 @@ const _: () = assert!(std::mem::size_of::<Vec3>() == 12 && std::mem::align_of::<
 pub const VSTREE_SAVE_ASCII: u32 = 1;
 const KNOWN_SAVE_FLAGS: u32 = VSTREE_SAVE_ASCII;
 
-/// Borrows the mesh behind a non-NULL handle pointer.
+/// Borrows the mesh behind a handle that must not be NULL.
 pub(crate) unsafe fn mesh_ref<'a>(mesh: *const vstree_mesh, argument: &str) -> FfiResult<&'a Mesh> {
-    let pointer = non_null(mesh, argument)?;
-    // SAFETY: non-NULL; the caller's contract is that it is a live handle from this library.
-    Ok(unsafe { &(*pointer).mesh })
+    Ok(&unsafe { handle::borrow(mesh, argument) }?.mesh)
 }
 
 /// Boxes `mesh` into a new handle for the caller.
 pub(crate) fn into_handle(mesh: Mesh) -> *mut vstree_mesh {
-    Box::into_raw(Box::new(vstree_mesh { mesh }))
+    handle::into_raw(vstree_mesh { mesh })
 }
 
 /// Copies a flat array of `3 × n` values into `n` triples in one `memcpy`.
@@ -226,12 +224,7 @@ pub unsafe extern "C" fn vstree_mesh_save(mesh: *const vstree_mesh, path: *const
 /// mesh another thread is using.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_mesh_free(mesh: *mut vstree_mesh) {
-    guard_or((), || {
-        if !mesh.is_null() {
-            // SAFETY: the caller gives a handle this library boxed, and gives up ownership.
-            drop(unsafe { Box::from_raw(mesh) });
-        }
-    })
+    unsafe { handle::free(mesh) }
 }
 
 /// The number of vertices (points, for a point cloud); 0 for NULL. Thread-safe.

@@ -12,10 +12,10 @@
 //! - a failing call leaves a message naming the function and the offending argument or field
 //!   in a thread-local buffer ([`vstree_last_error_message`]).
 //!
-//! One idea per file: [`arrays`] checks caller arrays, [`params`] reads versioned structs,
-//! [`progress`] adapts the C callback, [`version`] holds the version, [`mesh`], [`simplify`] and
-//! [`tree`] are the three handles; [`normals`] estimates normals into a new mesh, and
-//! [`reconstruct`] is the fourth handle.
+//! One idea per file: [`arrays`] checks caller arrays, [`handle`] boxes, borrows and frees
+//! handles, [`params`] reads versioned structs, [`progress`] adapts the C callback, [`version`]
+//! holds the version, [`mesh`], [`simplify`] and [`tree`] are the three handles; [`normals`]
+//! estimates normals into a new mesh, and [`reconstruct`] is the fourth handle.
 // The C names are the Rust names, so a symbol in the header can be grepped for here.
 #![allow(non_camel_case_types)]
 // Each function documents what its pointer arguments must be (a handle from a named call, or an
@@ -23,6 +23,7 @@
 #![allow(clippy::missing_safety_doc)]
 
 pub mod arrays;
+pub mod handle;
 pub mod mesh;
 pub mod params;
 pub mod progress;
@@ -34,6 +35,7 @@ pub mod normals;
 pub mod reconstruct;
 
 use crate::error::Error;
+use params::CEnum;
 use std::cell::RefCell;
 use std::ffi::{c_char, CStr, CString};
 use std::panic::{self, AssertUnwindSafe};
@@ -84,6 +86,21 @@ pub enum vstree_status {
     /// keep running. Please report the message.
     Internal = 12,
 }
+params::c_enum!(vstree_status {
+    Ok = "VSTREE_STATUS_OK",
+    NullPointer = "VSTREE_STATUS_NULL_POINTER",
+    InvalidArgument = "VSTREE_STATUS_INVALID_ARGUMENT",
+    InvalidParameter = "VSTREE_STATUS_INVALID_PARAMETER",
+    InvalidInput = "VSTREE_STATUS_INVALID_INPUT",
+    TooLarge = "VSTREE_STATUS_TOO_LARGE",
+    OutOfMemory = "VSTREE_STATUS_OUT_OF_MEMORY",
+    Io = "VSTREE_STATUS_IO",
+    Parse = "VSTREE_STATUS_PARSE",
+    UnsupportedFormat = "VSTREE_STATUS_UNSUPPORTED_FORMAT",
+    Cancelled = "VSTREE_STATUS_CANCELLED",
+    BufferTooSmall = "VSTREE_STATUS_BUFFER_TOO_SMALL",
+    Internal = "VSTREE_STATUS_INTERNAL",
+});
 
 /// A failed call's status and its detail, before it is stored as the last error.
 #[derive(Debug)]
@@ -218,21 +235,23 @@ pub(crate) fn non_null<T>(pointer: *const T, argument: &str) -> FfiResult<*const
 /// Numbers that are no status give "unknown status".
 #[no_mangle]
 pub extern "C" fn vstree_status_str(status: i32) -> *const c_char {
+    let Some(status) = vstree_status::from_raw(status) else {
+        return c"unknown status".as_ptr();
+    };
     let text: &'static CStr = match status {
-        0 => c"success",
-        1 => c"a required pointer argument is NULL",
-        2 => c"invalid argument",
-        3 => c"a parameter is out of its range",
-        4 => c"invalid input geometry",
-        5 => c"input too large",
-        6 => c"out of memory",
-        7 => c"file could not be read or written",
-        8 => c"malformed file",
-        9 => c"unsupported file format",
-        10 => c"cancelled by the progress callback",
-        11 => c"output buffer too small",
-        12 => c"internal error in vstree",
-        _ => c"unknown status",
+        vstree_status::Ok => c"success",
+        vstree_status::NullPointer => c"a required pointer argument is NULL",
+        vstree_status::InvalidArgument => c"invalid argument",
+        vstree_status::InvalidParameter => c"a parameter is out of its range",
+        vstree_status::InvalidInput => c"invalid input geometry",
+        vstree_status::TooLarge => c"input too large",
+        vstree_status::OutOfMemory => c"out of memory",
+        vstree_status::Io => c"file could not be read or written",
+        vstree_status::Parse => c"malformed file",
+        vstree_status::UnsupportedFormat => c"unsupported file format",
+        vstree_status::Cancelled => c"cancelled by the progress callback",
+        vstree_status::BufferTooSmall => c"output buffer too small",
+        vstree_status::Internal => c"internal error in vstree",
     };
     text.as_ptr()
 }
@@ -323,6 +342,37 @@ mod tests {
         let copied = unsafe { CStr::from_ptr(buffer.as_ptr()) }.to_str().unwrap();
         assert!(full.starts_with(copied) && copied.len() < 8, "{copied}");
         assert_eq!(unsafe { vstree_last_error_copy(std::ptr::null_mut(), 0) }, n);
+    }
+
+    /// The `NAME = value` lines of `enum c_name` in the committed header.
+    fn header_variants(c_name: &str) -> Vec<(String, i32)> {
+        let header = include_str!("../../include/vstree.h");
+        let start = header.find(&format!("enum {c_name}\n")).unwrap_or_else(|| panic!("no enum {c_name}"));
+        let body = &header[start..start + header[start..].find("};").unwrap()];
+        body.lines()
+            .filter_map(|line| line.trim().strip_suffix(',')?.split_once(" = "))
+            .map(|(name, value)| (name.to_string(), value.parse().unwrap()))
+            .collect()
+    }
+
+    fn check_against_header<E: CEnum>(c_name: &str) {
+        let ours: Vec<(String, i32)> = E::VARIANTS.iter().map(|&(v, name)| (name.to_string(), v.raw())).collect();
+        assert_eq!(ours, header_variants(c_name), "{c_name}");
+        for &(v, _) in E::VARIANTS {
+            assert!(E::from_raw(v.raw()).is_some_and(|w| w.raw() == v.raw()));
+        }
+        assert!(E::from_raw(-1).is_none() && E::from_raw(i32::MAX).is_none());
+    }
+
+    #[test]
+    fn c_enums_list_every_variant_the_header_has() {
+        check_against_header::<vstree_status>("vstree_status");
+        check_against_header::<simplify::vstree_tree_kind>("vstree_tree_kind");
+        check_against_header::<simplify::vstree_metric>("vstree_metric");
+        check_against_header::<simplify::vstree_sampling>("vstree_sampling");
+        check_against_header::<simplify::vstree_keep_topology>("vstree_keep_topology");
+        check_against_header::<tree::vstree_node_kind>("vstree_node_kind");
+        check_against_header::<tree::vstree_label_kind>("vstree_label_kind");
     }
 
     #[test]

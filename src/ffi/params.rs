@@ -60,6 +60,44 @@ pub(crate) fn one_of(field: &str, value: i32, allowed: &[(i32, &str)]) -> FfiRes
     if allowed.iter().any(|&(v, _)| v == value) {
         return Ok(value);
     }
-    let names: Vec<String> = allowed.iter().map(|(v, n)| format!("{v} ({n})")).collect();
-    Err(Failure::parameter(field, format!("{value}: must be one of {}", names.join(", "))))
+    Err(not_one_of(field, value, allowed.iter().copied()))
+}
+
+/// The failure of a field that holds none of the `allowed` values, naming them all.
+fn not_one_of<'a>(field: &str, value: i32, allowed: impl Iterator<Item = (i32, &'a str)>) -> Failure {
+    let names: Vec<String> = allowed.map(|(v, n)| format!("{v} ({n})")).collect();
+    Failure::parameter(field, format!("{value}: must be one of {}", names.join(", ")))
+}
+
+/// A C enum (`#[repr(i32)]`) whose values cross the boundary as plain integers. A raw value
+/// becomes the enum once, where it comes in ([`CEnum::from_raw`], [`enum_field`]); code after
+/// that matches on variants.
+pub(crate) trait CEnum: Copy + 'static {
+    /// Every variant with the name the header gives it, in the header's order.
+    const VARIANTS: &'static [(Self, &'static str)];
+    /// The variant's value in the header.
+    fn raw(self) -> i32;
+    /// The variant whose value is `raw`, if there is one.
+    fn from_raw(raw: i32) -> Option<Self> {
+        Self::VARIANTS.iter().find(|(v, _)| v.raw() == raw).map(|&(v, _)| v)
+    }
+}
+
+/// Implements [`CEnum`] for a `#[repr(i32)]` enum: `c_enum!(vstree_x { A = "VSTREE_X_A", .. })`.
+macro_rules! c_enum {
+    ($enum:ident { $($variant:ident = $name:literal),+ $(,)? }) => {
+        impl $crate::ffi::params::CEnum for $enum {
+            const VARIANTS: &'static [(Self, &'static str)] = &[$(($enum::$variant, $name)),+];
+            fn raw(self) -> i32 {
+                self as i32
+            }
+        }
+    };
+}
+pub(crate) use c_enum;
+
+/// Reads a C enum field of a parameter struct; a value that is no variant fails, naming the
+/// field and every variant.
+pub(crate) fn enum_field<E: CEnum>(field: &str, value: i32) -> FfiResult<E> {
+    E::from_raw(value).ok_or_else(|| not_one_of(field, value, E::VARIANTS.iter().map(|&(v, n)| (v.raw(), n))))
 }

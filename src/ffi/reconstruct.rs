@@ -1,15 +1,15 @@
 //! Surface reconstruction from a point cloud: the parameter struct, the call, and its result
 //! handle with the output mesh and statistics.
 
-use super::mesh::{into_handle, mesh_ref, vstree_mesh};
+use super::mesh::{mesh_ref, vstree_mesh};
 use super::normals::{flag, orientation, orientation_value, threads};
 use super::params::{self, one_of, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
-use super::{guard, guard_or, non_null, vstree_status, write_out, FfiResult};
+use super::{guard, guard_or, handle, non_null, vstree_status, write_out, FfiResult};
 use crate::normals::NormalParams;
 use crate::reconstruct::{reconstruct, BaseMesh, Closure, ReconstructParams, ReconstructStats, RefinementStop};
 use crate::tree::{Metric, TreeKind, TreeParams};
-use std::ffi::c_void;
+use std::ffi::{c_char, c_void};
 use std::mem::size_of;
 use std::time::Instant;
 
@@ -295,6 +295,11 @@ pub const VSTREE_REFINEMENT_STOPPED_MAX_LEVELS: u32 = 2;
 /// `stopped` value: the next level would have exceeded `max_triangles`; raise it or the target.
 pub const VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET: u32 = 3;
 
+/// The refinement stop a `stopped` value means, if it is one.
+fn refinement_stop(stopped: u32) -> Option<RefinementStop> {
+    RefinementStop::ALL.into_iter().find(|&stop| stopped_value(stop) == stopped)
+}
+
 /// The C value of a refinement stop.
 fn stopped_value(stop: RefinementStop) -> u32 {
     match stop {
@@ -386,8 +391,8 @@ pub unsafe extern "C" fn vstree_reconstruct(
         let params = unsafe { read_reconstruct_params(params) }?;
         let (out, s) = with_progress(progress, user_data, |p| reconstruct(cloud, &params, p))?;
         let stats = stats_of(&s, cloud.positions.len(), start.elapsed().as_secs_f64());
-        let result = Box::new(vstree_reconstruct_result { mesh: vstree_mesh { mesh: out }, stats });
-        unsafe { write_out(out_result, Box::into_raw(result)) };
+        let result = vstree_reconstruct_result { mesh: vstree_mesh { mesh: out }, stats };
+        unsafe { write_out(out_result, handle::into_raw(result)) };
         Ok(())
     })
 }
@@ -399,11 +404,7 @@ pub unsafe extern "C" fn vstree_reconstruct(
 pub unsafe extern "C" fn vstree_reconstruct_result_get_mesh(
     result: *const vstree_reconstruct_result,
 ) -> *const vstree_mesh {
-    guard_or(std::ptr::null(), || match result.is_null() {
-        true => std::ptr::null(),
-        // SAFETY: a live result from vstree_reconstruct(), by the caller's contract.
-        false => unsafe { &(*result).mesh as *const vstree_mesh },
-    })
+    unsafe { handle::part(result, |r| &r.mesh) }
 }
 
 /// The statistics of the reconstruction, owned by `result` (valid until it is freed; do not
@@ -412,23 +413,14 @@ pub unsafe extern "C" fn vstree_reconstruct_result_get_mesh(
 pub unsafe extern "C" fn vstree_reconstruct_result_get_stats(
     result: *const vstree_reconstruct_result,
 ) -> *const vstree_reconstruct_stats {
-    guard_or(std::ptr::null(), || match result.is_null() {
-        true => std::ptr::null(),
-        // SAFETY: as above.
-        false => unsafe { &(*result).stats as *const vstree_reconstruct_stats },
-    })
+    unsafe { handle::part(result, |r| &r.stats) }
 }
 
 /// Frees a result of vstree_reconstruct() and the mesh and statistics it owns. NULL is a
 /// no-op.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_reconstruct_result_free(result: *mut vstree_reconstruct_result) {
-    guard_or((), || {
-        if !result.is_null() {
-            // SAFETY: a result this library boxed; the caller gives up ownership.
-            drop(unsafe { Box::from_raw(result) });
-        }
-    })
+    unsafe { handle::free(result) }
 }
 
 /// Moves the mesh out of a reconstruction result into its own handle: `*out_mesh` gets a new
@@ -440,14 +432,16 @@ pub unsafe extern "C" fn vstree_reconstruct_result_take_mesh(
     result: *mut vstree_reconstruct_result,
     out_mesh: *mut *mut vstree_mesh,
 ) -> vstree_status {
-    guard("vstree_reconstruct_result_take_mesh", || {
-        non_null(out_mesh, "out_mesh")?;
-        let result = non_null(result, "result")?;
-        // SAFETY: a result this library boxed; the caller gives up ownership.
-        let result = unsafe { Box::from_raw(result.cast_mut()) };
-        unsafe { write_out(out_mesh, into_handle(result.mesh.mesh)) };
-        Ok(())
-    })
+    unsafe { handle::take_mesh("vstree_reconstruct_result_take_mesh", result, out_mesh, |r| r.mesh.mesh) }
+}
+
+/// The name of a `stopped` value of ::vstree_reconstruct_stats, the end of its
+/// VSTREE_REFINEMENT_STOPPED_ constant in lower case: "target", "no_detail", "max_levels" or
+/// "triangle_budget"; other numbers give "unknown". A static, NUL-terminated string: never NULL,
+/// never to be freed. Thread-safe. Since 0.4.0.
+#[no_mangle]
+pub extern "C" fn vstree_refinement_stopped_str(stopped: u32) -> *const c_char {
+    guard_or(c"unknown".as_ptr(), || refinement_stop(stopped).map_or(c"unknown", RefinementStop::as_c_str).as_ptr())
 }
 
 #[cfg(test)]

@@ -1,10 +1,10 @@
 //! Clustering simplification: the parameter struct (shared with vstree_tree_build(), which
 //! builds the same tree), the call, and its result handle with the output mesh and statistics.
 
-use super::mesh::{into_handle, mesh_ref, vstree_mesh};
-use super::params::{self, one_of, Versioned};
+use super::mesh::{mesh_ref, vstree_mesh};
+use super::params::{self, c_enum, enum_field, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
-use super::{guard, guard_or, non_null, vstree_status, write_out, FfiResult};
+use super::{guard, handle, non_null, vstree_status, write_out, FfiResult};
 use crate::samples::MeshSampling;
 use crate::simplify::{simplify, KeepTopology, SimplifyParams};
 use crate::tree::{Metric, TreeKind, TreeParams, TreeStats};
@@ -21,6 +21,7 @@ pub enum vstree_tree_kind {
     /// A plain octree with the same metric and thresholds: the baseline to compare with.
     Octree = 1,
 }
+c_enum!(vstree_tree_kind { VsTree = "VSTREE_TREE_KIND_VS_TREE", Octree = "VSTREE_TREE_KIND_OCTREE" });
 
 /// The error metric that decides whether a cell is split (the `metric` field).
 #[repr(i32)]
@@ -36,6 +37,7 @@ pub enum vstree_metric {
     /// Sample count: a cell with at most `error` samples is a leaf.
     Density = 2,
 }
+c_enum!(vstree_metric { L2 = "VSTREE_METRIC_L2", L21 = "VSTREE_METRIC_L21", Density = "VSTREE_METRIC_DENSITY" });
 
 /// Which mesh elements become the tree's samples (the `sampling` field). Point clouds always
 /// use their points.
@@ -48,6 +50,7 @@ pub enum vstree_sampling {
     /// One sample per non-degenerate triangle, at its centre, with its normal.
     FaceCenters = 1,
 }
+c_enum!(vstree_sampling { Vertices = "VSTREE_SAMPLING_VERTICES", FaceCenters = "VSTREE_SAMPLING_FACE_CENTERS" });
 
 /// Whether vstree_simplify() keeps the input's topology (the `keep_topology` field).
 #[repr(i32)]
@@ -64,6 +67,11 @@ pub enum vstree_keep_topology {
     /// non-manifold edges.
     Off = 2,
 }
+c_enum!(vstree_keep_topology {
+    Auto = "VSTREE_KEEP_TOPOLOGY_AUTO",
+    On = "VSTREE_KEEP_TOPOLOGY_ON",
+    Off = "VSTREE_KEEP_TOPOLOGY_OFF",
+});
 
 /// Parameters of vstree_simplify() and vstree_tree_build(). Always start from
 /// vstree_simplify_params_default() and change fields by name: it sets `struct_size`, and
@@ -146,27 +154,18 @@ pub extern "C" fn vstree_simplify_params_default() -> vstree_simplify_params {
 /// Reads and checks the caller's parameters (NULL: defaults), naming any bad field.
 pub(crate) unsafe fn read_params(pointer: *const vstree_simplify_params) -> FfiResult<SimplifyParams> {
     let p = unsafe { params::read(pointer, "params") }?;
-    let kind =
-        match one_of("tree_kind", p.tree_kind, &[(0, "VSTREE_TREE_KIND_VS_TREE"), (1, "VSTREE_TREE_KIND_OCTREE")])? {
-            0 => TreeKind::VsTree,
-            _ => TreeKind::Octree,
-        };
-    let metric = match one_of(
-        "metric",
-        p.metric,
-        &[(0, "VSTREE_METRIC_L2"), (1, "VSTREE_METRIC_L21"), (2, "VSTREE_METRIC_DENSITY")],
-    )? {
-        0 => Metric::L2,
-        1 => Metric::L21,
-        _ => Metric::Density,
+    let kind = match enum_field("tree_kind", p.tree_kind)? {
+        vstree_tree_kind::VsTree => TreeKind::VsTree,
+        vstree_tree_kind::Octree => TreeKind::Octree,
     };
-    let sampling = match one_of(
-        "sampling",
-        p.sampling,
-        &[(0, "VSTREE_SAMPLING_VERTICES"), (1, "VSTREE_SAMPLING_FACE_CENTERS")],
-    )? {
-        0 => MeshSampling::Vertices,
-        _ => MeshSampling::FaceCenters,
+    let metric = match enum_field("metric", p.metric)? {
+        vstree_metric::L2 => Metric::L2,
+        vstree_metric::L21 => Metric::L21,
+        vstree_metric::Density => Metric::Density,
+    };
+    let sampling = match enum_field("sampling", p.sampling)? {
+        vstree_sampling::Vertices => MeshSampling::Vertices,
+        vstree_sampling::FaceCenters => MeshSampling::FaceCenters,
     };
     let tree = TreeParams {
         kind,
@@ -181,14 +180,10 @@ pub(crate) unsafe fn read_params(pointer: *const vstree_simplify_params) -> FfiR
     if p.threads > 1024 {
         return Err(super::Failure::parameter("threads", format!("{}: must be 0 (all cores) to 1024", p.threads)));
     }
-    let keep_topology = match one_of(
-        "keep_topology",
-        p.keep_topology,
-        &[(0, "VSTREE_KEEP_TOPOLOGY_AUTO"), (1, "VSTREE_KEEP_TOPOLOGY_ON"), (2, "VSTREE_KEEP_TOPOLOGY_OFF")],
-    )? {
-        0 => KeepTopology::Auto,
-        1 => KeepTopology::On,
-        _ => KeepTopology::Off,
+    let keep_topology = match enum_field("keep_topology", p.keep_topology)? {
+        vstree_keep_topology::Auto => KeepTopology::Auto,
+        vstree_keep_topology::On => KeepTopology::On,
+        vstree_keep_topology::Off => KeepTopology::Off,
     };
     Ok(SimplifyParams {
         tree,
@@ -317,8 +312,8 @@ pub unsafe extern "C" fn vstree_simplify(
             kept_topology: u32::from(s.kept_topology),
             target_faces: params.target_faces as u32,
         };
-        let result = Box::new(vstree_simplify_result { mesh: vstree_mesh { mesh: out }, stats });
-        unsafe { write_out(out_result, Box::into_raw(result)) };
+        let result = vstree_simplify_result { mesh: vstree_mesh { mesh: out }, stats };
+        unsafe { write_out(out_result, handle::into_raw(result)) };
         Ok(())
     })
 }
@@ -328,11 +323,7 @@ pub unsafe extern "C" fn vstree_simplify(
 /// function (counts, copies, vstree_mesh_save(), even vstree_simplify() again). NULL for NULL.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_simplify_result_get_mesh(result: *const vstree_simplify_result) -> *const vstree_mesh {
-    guard_or(std::ptr::null(), || match result.is_null() {
-        true => std::ptr::null(),
-        // SAFETY: a live result from vstree_simplify(), by the caller's contract.
-        false => unsafe { &(*result).mesh as *const vstree_mesh },
-    })
+    unsafe { handle::part(result, |r| &r.mesh) }
 }
 
 /// The statistics of the simplification, owned by `result` (valid until it is freed; do not
@@ -341,22 +332,13 @@ pub unsafe extern "C" fn vstree_simplify_result_get_mesh(result: *const vstree_s
 pub unsafe extern "C" fn vstree_simplify_result_get_stats(
     result: *const vstree_simplify_result,
 ) -> *const vstree_simplify_stats {
-    guard_or(std::ptr::null(), || match result.is_null() {
-        true => std::ptr::null(),
-        // SAFETY: as above.
-        false => unsafe { &(*result).stats as *const vstree_simplify_stats },
-    })
+    unsafe { handle::part(result, |r| &r.stats) }
 }
 
 /// Frees a result of vstree_simplify() and the mesh and statistics it owns. NULL is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_simplify_result_free(result: *mut vstree_simplify_result) {
-    guard_or((), || {
-        if !result.is_null() {
-            // SAFETY: a result this library boxed; the caller gives up ownership.
-            drop(unsafe { Box::from_raw(result) });
-        }
-    })
+    unsafe { handle::free(result) }
 }
 
 /// Moves the mesh out of a simplification result into its own handle, for callers that want to
@@ -368,14 +350,7 @@ pub unsafe extern "C" fn vstree_simplify_result_take_mesh(
     result: *mut vstree_simplify_result,
     out_mesh: *mut *mut vstree_mesh,
 ) -> vstree_status {
-    guard("vstree_simplify_result_take_mesh", || {
-        non_null(out_mesh, "out_mesh")?;
-        let result = non_null(result, "result")?;
-        // SAFETY: a result this library boxed; the caller gives up ownership.
-        let result = unsafe { Box::from_raw(result.cast_mut()) };
-        unsafe { write_out(out_mesh, into_handle(result.mesh.mesh)) };
-        Ok(())
-    })
+    unsafe { handle::take_mesh("vstree_simplify_result_take_mesh", result, out_mesh, |r| r.mesh.mesh) }
 }
 
 #[cfg(test)]

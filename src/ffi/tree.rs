@@ -4,15 +4,14 @@
 
 use super::arrays::copy_out;
 use super::mesh::{mesh_ref, vstree_mesh};
+use super::params::{c_enum, CEnum};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::simplify::{read_params, tree_figures, vstree_simplify_params};
-use super::{guard, guard_or, non_null, vstree_status, write_out, Failure, FfiResult};
+use super::{guard, guard_or, handle, non_null, vstree_status, write_out, Failure, FfiResult};
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
-use crate::quadric::CellStats;
 use crate::simplify::{cluster_mesh, vertex_labels, Clustered, SimplifyParams, NO_CLUSTER};
-use crate::tree::{self, Metric, NodeKind, VsTree};
-use rayon::prelude::*;
+use crate::tree::NodeKind;
 use std::ffi::c_void;
 use std::time::Instant;
 
@@ -32,6 +31,20 @@ pub enum vstree_node_kind {
     /// A quadtree cell: a square in its T-node's plane, with up to 4 S-node children.
     Surface = 2,
 }
+c_enum!(vstree_node_kind {
+    Volume = "VSTREE_NODE_KIND_VOLUME",
+    Transition = "VSTREE_NODE_KIND_TRANSITION",
+    Surface = "VSTREE_NODE_KIND_SURFACE",
+});
+
+/// The C kind of a node.
+fn node_kind(kind: NodeKind) -> vstree_node_kind {
+    match kind {
+        NodeKind::Volume => vstree_node_kind::Volume,
+        NodeKind::Transition => vstree_node_kind::Transition,
+        NodeKind::Surface => vstree_node_kind::Surface,
+    }
+}
 
 /// What vstree_tree_copy_vertex_labels() gives per input vertex.
 #[repr(i32)]
@@ -43,6 +56,7 @@ pub enum vstree_label_kind {
     /// cluster, or VSTREE_NO_INDEX when the cluster is an octree leaf or there is none.
     TNode = 1,
 }
+c_enum!(vstree_label_kind { Cluster = "VSTREE_LABEL_KIND_CLUSTER", TNode = "VSTREE_LABEL_KIND_T_NODE" });
 
 /// One node of the tree, as vstree_tree_copy_nodes() gives them: node 0 is the root, and a
 /// node's children are contiguous.
@@ -203,7 +217,7 @@ pub unsafe extern "C" fn vstree_tree_build(
         let params = unsafe { read_params(params) }?;
         let mut tree = with_progress(progress, user_data, |p| build(mesh, &params, p))?;
         tree.stats.seconds_total = start.elapsed().as_secs_f64();
-        unsafe { write_out(out_tree, Box::into_raw(Box::new(tree))) };
+        unsafe { write_out(out_tree, handle::into_raw(tree)) };
         Ok(())
     })
 }
@@ -246,7 +260,7 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
             parent: n.parent,
             first_child: n.first_child,
             child_count: n.child_count.into(),
-            kind: n.kind as i32,
+            kind: node_kind(n.kind).raw(),
             depth: n.depth.into(),
             sample_count: n.count,
             t_node: t_of(i),
@@ -302,7 +316,7 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
         }
         level.leaves += u64::from(n.is_leaf());
     }
-    let errors = threads.run(|| cluster_errors(&tree, &clusters.leaves));
+    let errors = threads.run(|| tree.node_errors(&clusters.leaves));
     let max_error = errors.iter().copied().fold(0.0, f64::max);
     let mean_error = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
     progress.report(1.0, "done")?;
@@ -332,88 +346,43 @@ fn build(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> FfiRe
     Ok(vstree_tree { stats, nodes, t_nodes, levels, cluster_labels, t_node_labels })
 }
 
-/// Each cluster's error: the figure the tree's split test compares with `error`.
-fn cluster_errors(tree: &VsTree, leaves: &[u32]) -> Vec<f64> {
-    let origin = tree.root().center.as_dvec3();
-    let scale = f64::from(tree.diagonal).powi(2);
-    leaves
-        .par_iter()
-        .map(|&leaf| {
-            let node = &tree.nodes[leaf as usize];
-            let mut stats = CellStats::default();
-            for s in tree.samples_of(node) {
-                stats.add(s.position.as_dvec3() - origin, s.normal.as_dvec3());
-            }
-            match tree.params.metric {
-                Metric::L2 => {
-                    let frame = (node.kind == NodeKind::Surface).then(|| &tree.frames[node.frame as usize]);
-                    let x = tree::representative(node, frame, &stats, origin);
-                    let absolute = stats.quadric_at(x - origin);
-                    if scale > 0.0 {
-                        absolute / scale
-                    } else {
-                        0.0
-                    }
-                }
-                Metric::L21 => stats.normal_deviation(),
-                Metric::Density => stats.count as f64,
-            }
-        })
-        .collect()
-}
-
 /// Frees a tree made by vstree_tree_build(). NULL is a no-op.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_free(tree: *mut vstree_tree) {
-    guard_or((), || {
-        if !tree.is_null() {
-            // SAFETY: a tree this library boxed; the caller gives up ownership.
-            drop(unsafe { Box::from_raw(tree) });
-        }
-    })
-}
-
-/// Borrows the tree behind a handle, or `None` for NULL.
-unsafe fn tree_opt<'a>(tree: *const vstree_tree) -> Option<&'a vstree_tree> {
-    // SAFETY: NULL or a live handle, by the caller's contract.
-    unsafe { tree.as_ref() }
-}
-
-unsafe fn tree_ref<'a>(tree: *const vstree_tree) -> FfiResult<&'a vstree_tree> {
-    unsafe { tree_opt(tree) }.ok_or_else(|| Failure::null("tree"))
+    unsafe { handle::free(tree) }
 }
 
 /// The tree's statistics, owned by `tree` (valid until it is freed; do not free it). NULL for
 /// NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_get_stats(tree: *const vstree_tree) -> *const vstree_tree_stats {
-    guard_or(std::ptr::null(), || unsafe { tree_opt(tree) }.map_or(std::ptr::null(), |t| &t.stats as *const _))
+    unsafe { handle::part(tree, |t| &t.stats) }
 }
 
 /// Number of nodes (the length vstree_tree_copy_nodes() needs); 0 for NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_node_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.nodes.len()))
+    guard_or(0, || unsafe { handle::borrow_opt(tree) }.map_or(0, |t| t.nodes.len()))
 }
 
 /// Number of T-nodes (the length vstree_tree_copy_t_nodes() needs); 0 for NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_t_node_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.t_nodes.len()))
+    guard_or(0, || unsafe { handle::borrow_opt(tree) }.map_or(0, |t| t.t_nodes.len()))
 }
 
 /// Number of levels, max_depth + 1 (the length vstree_tree_copy_levels() needs); 0 for NULL.
 /// Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_level_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.levels.len()))
+    guard_or(0, || unsafe { handle::borrow_opt(tree) }.map_or(0, |t| t.levels.len()))
 }
 
 /// Number of labels: the vertex (point) count of the mesh the tree was built from (the length
 /// vstree_tree_copy_vertex_labels() needs); 0 for NULL. Thread-safe.
 #[no_mangle]
 pub unsafe extern "C" fn vstree_tree_vertex_count(tree: *const vstree_tree) -> usize {
-    guard_or(0, || unsafe { tree_opt(tree) }.map_or(0, |t| t.cluster_labels.len()))
+    guard_or(0, || unsafe { handle::borrow_opt(tree) }.map_or(0, |t| t.cluster_labels.len()))
 }
 
 /// Copies every node into the caller's array `out` of `capacity` elements, which must be at
@@ -428,7 +397,7 @@ pub unsafe extern "C" fn vstree_tree_copy_nodes(
     capacity: usize,
 ) -> vstree_status {
     guard("vstree_tree_copy_nodes", || {
-        let tree = unsafe { tree_ref(tree) }?;
+        let tree = unsafe { handle::borrow(tree, "tree") }?;
         unsafe { copy_out(&tree.nodes, out, capacity, "out") }
     })
 }
@@ -445,7 +414,7 @@ pub unsafe extern "C" fn vstree_tree_copy_t_nodes(
     capacity: usize,
 ) -> vstree_status {
     guard("vstree_tree_copy_t_nodes", || {
-        let tree = unsafe { tree_ref(tree) }?;
+        let tree = unsafe { handle::borrow(tree, "tree") }?;
         unsafe { copy_out(&tree.t_nodes, out, capacity, "out") }
     })
 }
@@ -461,7 +430,7 @@ pub unsafe extern "C" fn vstree_tree_copy_levels(
     capacity: usize,
 ) -> vstree_status {
     guard("vstree_tree_copy_levels", || {
-        let tree = unsafe { tree_ref(tree) }?;
+        let tree = unsafe { handle::borrow(tree, "tree") }?;
         unsafe { copy_out(&tree.levels, out, capacity, "out") }
     })
 }
@@ -481,11 +450,11 @@ pub unsafe extern "C" fn vstree_tree_copy_vertex_labels(
     capacity: usize,
 ) -> vstree_status {
     guard("vstree_tree_copy_vertex_labels", || {
-        let tree = unsafe { tree_ref(tree) }?;
-        let labels = match kind {
-            0 => &tree.cluster_labels,
-            1 => &tree.t_node_labels,
-            _ => {
+        let tree = unsafe { handle::borrow(tree, "tree") }?;
+        let labels = match vstree_label_kind::from_raw(kind) {
+            Some(vstree_label_kind::Cluster) => &tree.cluster_labels,
+            Some(vstree_label_kind::TNode) => &tree.t_node_labels,
+            None => {
                 return Err(Failure::argument(
                     "kind",
                     format!(

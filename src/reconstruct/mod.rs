@@ -47,6 +47,7 @@ use crate::topology;
 use crate::tree::{self, NodeKind, TreeKind, TreeParams, TreeSample, TreeStats, VsTree};
 use glam::Vec3;
 use rayon::prelude::*;
+use std::ffi::CStr;
 use std::time::Instant;
 
 /// At most this many samples are measured for error(M, S).
@@ -248,6 +249,31 @@ pub enum RefinementStop {
     /// The next level would have exceeded `max_triangles`: the target asks for more triangles
     /// than allowed (raise `max_triangles` or the target, or lower the tree's bound).
     TriangleBudget,
+}
+
+impl RefinementStop {
+    /// Every reason.
+    /// cbindgen:ignore
+    pub const ALL: [RefinementStop; 4] =
+        [RefinementStop::Target, RefinementStop::NoDetail, RefinementStop::MaxLevels, RefinementStop::TriangleBudget];
+
+    /// The reason's name: "target", "no_detail", "max_levels" or "triangle_budget". The CLI
+    /// prints it, the C API gives it (vstree_refinement_stopped_str()), and the Python
+    /// bindings put it in their statistics.
+    pub fn as_str(self) -> &'static str {
+        // The names are ASCII, so never "".
+        self.as_c_str().to_str().unwrap_or_default()
+    }
+
+    /// [`RefinementStop::as_str`] as a static C string, for the C API.
+    pub fn as_c_str(self) -> &'static CStr {
+        match self {
+            RefinementStop::Target => c"target",
+            RefinementStop::NoDetail => c"no_detail",
+            RefinementStop::MaxLevels => c"max_levels",
+            RefinementStop::TriangleBudget => c"triangle_budget",
+        }
+    }
 }
 
 /// What [`reconstruct`] did.

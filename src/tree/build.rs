@@ -10,7 +10,7 @@
 
 use super::indicator::{frame, is_height_field, reach};
 use super::partition::partition;
-use super::{representative, Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
+use super::{Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
 use crate::error::{Error, Result};
 use crate::mesh::{check_positions, Aabb};
 use crate::progress::{Progress, Threads};
@@ -239,19 +239,10 @@ impl Builder {
         }
     }
 
-    /// The node's error in the units of [`Builder::threshold`]: for L2 the quadric at the
-    /// node's representative (absolute, squared), for L2,1 the normal deviation, for density
-    /// the sample count.
+    /// The node's error ([`Metric::cell_error`]) in the units of [`Builder::threshold`].
     pub(super) fn error(&self, part: &Part, node: &Node, stats: &CellStats) -> f64 {
-        match self.params.metric {
-            Metric::L2 => {
-                let frame = (node.kind == NodeKind::Surface).then(|| part.frame(node.frame));
-                let x = representative(node, frame, stats, self.origin);
-                stats.quadric_at(x - self.origin)
-            }
-            Metric::L21 => stats.normal_deviation(),
-            Metric::Density => stats.count as f64,
-        }
+        let frame = (node.kind == NodeKind::Surface).then(|| part.frame(node.frame));
+        self.params.metric.cell_error(node, frame, stats, self.origin)
     }
 
     /// The bound on [`Builder::error`] below which a node is a leaf.

@@ -15,6 +15,7 @@ mod validate;
 use crate::error::{shown, Error, Result};
 use crate::quadric::CellStats;
 use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
 
 pub use build::build;
 pub use fit::fit;
@@ -173,6 +174,23 @@ pub fn representative(node: &Node, frame: Option<&Frame>, stats: &CellStats, ori
     }
 }
 
+impl Metric {
+    /// The error of a cell under this metric, as the split test measures it before comparing:
+    /// L2, the quadric at the cell's [`representative`] (absolute, squared units); L2,1, the
+    /// normal deviation; density, the sample count. `stats` sums the cell's samples relative to
+    /// `origin`; `frame` is the frame of an S-node's T-node.
+    pub fn cell_error(self, node: &Node, frame: Option<&Frame>, stats: &CellStats, origin: DVec3) -> f64 {
+        match self {
+            Metric::L2 => {
+                let x = representative(node, frame, stats, origin);
+                stats.quadric_at(x - origin)
+            }
+            Metric::L21 => stats.normal_deviation(),
+            Metric::Density => stats.count as f64,
+        }
+    }
+}
+
 /// `Node::frame` of a V-node.
 pub const NO_FRAME: u32 = u32::MAX;
 
@@ -279,6 +297,33 @@ impl VsTree {
         &self.samples[node.range()]
     }
 
+    /// The error of `node` that the split test compares with `params.error`, in its units (L2
+    /// relative to the squared diagonal, L2,1 unitless, density in samples). Every leaf of a
+    /// tree built with a bound is within it, unless a single sample, the deepest level or the
+    /// smallest cell size stopped its split; every inner node is beyond it.
+    pub fn node_error(&self, node: &Node) -> f64 {
+        let origin = self.root().center.as_dvec3();
+        let stats = build::sum(self.samples_of(node), origin);
+        let frame = (node.kind == NodeKind::Surface).then(|| &self.frames[node.frame as usize]);
+        let error = self.params.metric.cell_error(node, frame, &stats, origin);
+        match self.params.metric {
+            Metric::L2 => {
+                let scale = f64::from(self.diagonal).powi(2);
+                if scale > 0.0 {
+                    error / scale
+                } else {
+                    0.0
+                }
+            }
+            Metric::L21 | Metric::Density => error,
+        }
+    }
+
+    /// [`VsTree::node_error`] of each of the nodes numbered `nodes`, in parallel.
+    pub fn node_errors(&self, nodes: &[u32]) -> Vec<f64> {
+        nodes.par_iter().map(|&i| self.node_error(&self.nodes[i as usize])).collect()
+    }
+
     pub fn stats(&self) -> TreeStats {
         let mut s = TreeStats { samples: self.samples.len(), nodes: self.nodes.len(), ..Default::default() };
         let (mut t_min, mut t_max) = (u32::MAX, 0);
@@ -308,5 +353,63 @@ impl VsTree {
             s.leaf_size_variance = (sum_sq / s.leaves as f64 - s.leaf_size_mean.powi(2)).max(0.0);
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::{Progress, Threads};
+    use crate::samples::{MeshSampling, SampleSet};
+    use crate::shapes;
+
+    fn tree_of(samples: &SampleSet, metric: Metric, error: f64) -> VsTree {
+        let params = TreeParams { metric, error, ..Default::default() };
+        build(samples, &params, &Threads::new(1).unwrap(), &mut Progress::none()).unwrap()
+    }
+
+    #[test]
+    fn node_error_gives_each_metric_s_figure() {
+        // A slab: 5 × 5 samples on z = 1 facing up and on z = -1 facing down. The quadric's
+        // minimiser is on z = 0, one unit from all 50 tangent planes; the mean normal is zero.
+        let mut samples = SampleSet::default();
+        for (z, nz) in [(1.0, 1.0), (-1.0, -1.0)] {
+            for i in 0..25 {
+                samples.positions.push(Vec3::new((i % 5) as f32, (i / 5) as f32, z));
+                samples.normals.push(Vec3::new(0.0, 0.0, nz));
+                samples.origin.push(samples.origin.len() as u32);
+            }
+        }
+        // Bounds the root is within, so it stays a leaf; the diagonal is 6 (4, 4, 2).
+        for (metric, bound, figure) in
+            [(Metric::L2, 2.0, 50.0 / 36.0), (Metric::L21, 4.0, 2.0), (Metric::Density, 50.0, 50.0)]
+        {
+            let tree = tree_of(&samples, metric, bound);
+            assert_eq!(tree.nodes.len(), 1, "{metric:?}");
+            let error = tree.node_error(tree.root());
+            assert!((error - figure).abs() < 1e-12, "{metric:?}: {error}, not {figure}");
+        }
+    }
+
+    #[test]
+    fn node_error_is_what_the_build_split_on() {
+        let samples = SampleSet::from_mesh(&shapes::torus(1.0, 0.3, 96, 48), MeshSampling::Vertices).unwrap();
+        for (metric, bound) in [(Metric::L2, 1e-3), (Metric::L21, 0.05), (Metric::Density, 40.0)] {
+            let tree = tree_of(&samples, metric, bound);
+            let all: Vec<u32> = (0..tree.nodes.len() as u32).collect();
+            let errors = tree.node_errors(&all);
+            let (mut leaves, mut inner) = (0, 0);
+            for (node, &error) in tree.nodes.iter().zip(&errors) {
+                assert_eq!(error, tree.node_error(node));
+                if !node.is_leaf() {
+                    assert!(error > bound * (1.0 - 1e-9), "{metric:?}: inner node with error {error}");
+                    inner += 1;
+                } else if node.count > 1 && u32::from(node.depth) < tree.params.max_depth {
+                    assert!(error <= bound * (1.0 + 1e-9), "{metric:?}: leaf with error {error}");
+                    leaves += 1;
+                }
+            }
+            assert!(leaves > 100 && inner > 10, "{metric:?}: {leaves} leaves, {inner} inner nodes checked");
+        }
     }
 }

@@ -149,6 +149,12 @@ static void version_and_errors(void) {
       CHECK(strcmp(vstree_status_str(code), "unknown status") != 0);
     }
   }
+  CHECK(strcmp(vstree_refinement_stopped_str(VSTREE_REFINEMENT_STOPPED_TARGET), "target") == 0);
+  CHECK(strcmp(vstree_refinement_stopped_str(VSTREE_REFINEMENT_STOPPED_NO_DETAIL), "no_detail") == 0);
+  CHECK(strcmp(vstree_refinement_stopped_str(VSTREE_REFINEMENT_STOPPED_MAX_LEVELS), "max_levels") == 0);
+  CHECK(strcmp(vstree_refinement_stopped_str(VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET), "triangle_budget") == 0);
+  CHECK(strcmp(vstree_refinement_stopped_str(4), "unknown") == 0);
+  CHECK(strcmp(vstree_refinement_stopped_str(UINT32_MAX), "unknown") == 0);
   /* The numbers are ABI: they must never change. */
   CHECK(VSTREE_STATUS_NULL_POINTER == 1 && VSTREE_STATUS_INVALID_PARAMETER == 3);
   CHECK(VSTREE_STATUS_CANCELLED == 10 && VSTREE_STATUS_INTERNAL == 12);

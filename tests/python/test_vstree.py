@@ -354,6 +354,15 @@ def test_reconstruct_a_torus_with_and_without_normals():
     np.testing.assert_array_equal(again.mesh.triangles, with_normals.mesh.triangles)
 
 
+def test_refinement_stops_are_named_by_the_library():
+    # The names the statistics' "stopped" takes come from vstree_refinement_stopped_str().
+    def name(value):
+        return vstree._ffi.lib.vstree_refinement_stopped_str(value).decode()
+
+    assert [name(v) for v in range(4)] == ["target", "no_detail", "max_levels", "triangle_budget"]
+    assert name(4) == name(2**32 - 1) == "unknown"
+
+
 def test_reconstruct_bad_input_and_parameters():
     p, n = torus_cloud(500)
     with pytest.raises(vstree.VstreeError) as e:

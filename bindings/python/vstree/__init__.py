@@ -657,7 +657,7 @@ def reconstruct(cloud, normals=None, progress=None, **params):
         if stats.struct_size < ctypes.sizeof(_ffi.ReconstructStats):
             raise VstreeError(Status.INTERNAL, "the library's statistics are older than this module")
         stats = _struct_dict(stats)
-        stats["stopped"] = _ffi.REFINEMENT_STOPPED.get(stats["stopped"], "unknown")
+        stats["stopped"] = lib.vstree_refinement_stopped_str(stats["stopped"]).decode()
         stats["thickened"] = bool(stats["thickened"])
         stats["open"] = bool(stats["open"])
     except BaseException:

@@ -258,10 +258,6 @@ class ReconstructStats(Structure):
     ]
 
 
-# Why refinement stopped (ReconstructStats.stopped), as the Python API names it.
-REFINEMENT_STOPPED = {0: "target", 1: "no_detail", 2: "max_levels", 3: "triangle_budget"}
-
-
 # ---- functions ------------------------------------------------------------------------------
 
 _F32P = POINTER(c_float)
@@ -325,6 +321,7 @@ _SIGNATURES = {
     "vstree_reconstruct_result_get_stats": (POINTER(ReconstructStats), [c_void_p]),
     "vstree_reconstruct_result_free": (None, [c_void_p]),
     "vstree_reconstruct_result_take_mesh": (status_t, [c_void_p, POINTER(c_void_p)]),
+    "vstree_refinement_stopped_str": (c_char_p, [c_uint32]),
 }
 
 for _name, (_restype, _argtypes) in _SIGNATURES.items():
