@@ -73,8 +73,7 @@ fn assert_closed_reconstruction(name: &str, cloud: &Mesh, genus: u32) {
     assert_eq!(stats.base_genus, Some(genus), "{name}: M0's genus");
     assert!(report.is_watertight(), "{name}: {report:?}");
     assert_eq!(report.genus(), Some(genus), "{name}: the result's genus");
-    // Measured 0 on every one; at most 0.23% (fertility) before each level was unfolded
-    // onto the samples' fit.
+    // Measured 0 on every one: each refined level is unfolded onto the samples' fit.
     assert!(folded_share(&mesh) < 1e-4, "{name}: {:.3}% folded triangles", 100.0 * folded_share(&mesh));
     // Nor any pair of triangles folded onto each other (the benchmark's folds, 150 degrees).
     let pairs = topology::adjacent_face_pairs(&mesh.triangles);
@@ -237,9 +236,8 @@ fn merged_bunny_scans_give_a_clean_bunny() {
     assert!(report.is_watertight(), "{report:?}");
     assert_eq!(report.genus(), Some(0), "handles in the bunny");
     assert!(regular_share(&mesh) > 0.9);
-    // Measured 0.86% (2.0% before folds that the leaves kept re-folding were moved along the
-    // normal only, 3.2% before thin parts were thickened): the leaves of misaligned
-    // overlapping scans disagree by more than the vertices' spacing.
+    // Measured 0.86%: the leaves of misaligned overlapping scans disagree by more than the
+    // vertices' spacing.
     assert!(folded_share(&mesh) < 0.015, "{:.2}% folded", 100.0 * folded_share(&mesh));
     // Measured 6.9e-4 (the zippered bunny is open underneath, where this one is closed).
     assert!(chamfer < 1e-3 * diagonal, "chamfer to bun_zipper {:.2e} x diagonal", chamfer / diagonal);
