@@ -24,6 +24,7 @@ use crate::knn::KdTree;
 use crate::linalg::Sym3;
 use crate::mesh::{check_positions, Mesh};
 use crate::progress::{Progress, Threads};
+use crate::union_find::UnionFind;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -580,7 +581,7 @@ impl Graph {
     /// whole trees so that `t` and `u` agree (Hoppe's traversal, without building the tree).
     fn spanning_forest(&self, edges: &[u32], progress: &mut Progress) -> Result<Parts> {
         let n = self.len();
-        let mut forest = SignedForest::new(n);
+        let mut forest = UnionFind::new(n);
         let mut joined = 0;
         for (e, &id) in edges.iter().enumerate() {
             if e % (1 << 22) == 0 {
@@ -589,7 +590,7 @@ impl Graph {
             let differ = id & OPPOSITE != 0;
             let id = (id & !OPPOSITE) as usize;
             let (t, u) = (id / self.k, self.rows[id] as usize);
-            if forest.union(t as u32, u as u32, differ) {
+            if forest.union_signed(t as u32, u as u32, differ) {
                 joined += 1;
                 if joined == n - 1 {
                     break;
@@ -601,7 +602,7 @@ impl Graph {
         let mut numbering = vec![u32::MAX; n];
         let mut components = 0u32;
         for t in 0..n {
-            let (root, parity) = forest.find(t as u32);
+            let (root, parity) = forest.find_signed(t as u32);
             if numbering[root as usize] == u32::MAX {
                 numbering[root as usize] = components;
                 components += 1;
@@ -732,83 +733,4 @@ struct Parts {
     component: Vec<u32>,
     flip: Vec<bool>,
     count: usize,
-}
-
-/// Union-find (union by rank, path compression) where every element also records whether its
-/// sign is opposite to its parent's. Parent and sign share one word, so a step up the tree is
-/// one memory access.
-struct SignedForest {
-    /// Parent index in the low 31 bits; the top bit set when the sign is opposite to the
-    /// parent's (to the root's after compression).
-    link: Vec<u32>,
-    rank: Vec<u8>,
-}
-
-const FLIP: u32 = 1 << 31;
-
-impl SignedForest {
-    /// A forest of `n < 2^31` single points.
-    fn new(n: usize) -> SignedForest {
-        SignedForest { link: (0..n as u32).collect(), rank: vec![0; n] }
-    }
-
-    /// The root of `x`'s tree and whether `x`'s sign is opposite to the root's.
-    fn find(&mut self, x: u32) -> (u32, bool) {
-        let (mut root, mut parity) = (x, 0);
-        loop {
-            let link = self.link[root as usize];
-            if link & !FLIP == root {
-                break;
-            }
-            parity ^= link & FLIP;
-            root = link & !FLIP;
-        }
-        // Point every node on the path straight at the root, with its sign relative to it.
-        let (mut node, mut to_root) = (x, parity);
-        while node != root {
-            let link = self.link[node as usize];
-            self.link[node as usize] = root | to_root;
-            to_root ^= link & FLIP;
-            node = link & !FLIP;
-        }
-        (root, parity != 0)
-    }
-
-    /// Joins the trees of `a` and `b` so that their signs differ exactly when `differ`;
-    /// false when they were already joined.
-    fn union(&mut self, a: u32, b: u32, differ: bool) -> bool {
-        let (ra, pa) = self.find(a);
-        let (rb, pb) = self.find(b);
-        if ra == rb {
-            return false;
-        }
-        let (big, small) = if self.rank[ra as usize] >= self.rank[rb as usize] { (ra, rb) } else { (rb, ra) };
-        // sign(a) ^ sign(b) = pa ^ pb ^ (sign of small relative to big) must equal `differ`.
-        let flip = if pa ^ pb ^ differ { FLIP } else { 0 };
-        self.link[small as usize] = big | flip;
-        if self.rank[big as usize] == self.rank[small as usize] {
-            self.rank[big as usize] += 1;
-        }
-        true
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn signed_forest_tracks_relative_signs() {
-        let mut forest = SignedForest::new(6);
-        assert!(forest.union(0, 1, true));
-        assert!(forest.union(2, 3, false));
-        assert!(forest.union(1, 2, true));
-        assert!(forest.union(4, 3, true));
-        assert!(!forest.union(0, 3, false));
-        // Signs relative to point 0: 1 flipped, 2 = 1 flipped again, 3 = 2, 4 opposite to 3.
-        let sign = |f: &mut SignedForest, x| f.find(x).1 ^ f.find(0).1;
-        let signs: Vec<bool> = (0..5).map(|x| sign(&mut forest, x)).collect();
-        assert_eq!(signs, [false, true, false, false, true]);
-        assert_ne!(forest.find(5).0, forest.find(0).0);
-    }
 }
