@@ -25,6 +25,7 @@ pub mod simplify;
 pub mod spatial;
 pub mod topology;
 pub mod tree;
+mod union_find;
 
 pub use error::{Error, Result};
 pub use mesh::{Aabb, Mesh};

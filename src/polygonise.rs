@@ -1,6 +1,8 @@
-//! Marching tetrahedra: the cube split and per-tetrahedron triangulation shared by the dense
-//! polygoniser of generated shapes ([`crate::shapes::implicit_mesh`]) and the sparse surface
-//! tracker that reconstruction uses to mesh its implicit function.
+//! Marching tetrahedra of an implicit function over a regular grid, in two ways that share the
+//! grid, the vertex placement and the per-cube triangulation: densely over the whole grid
+//! ([`polygonise_grid`], for generated shapes, [`crate::shapes::implicit_mesh`]), and by
+//! tracking the surface from seed cells ([`track_surface`], which reconstruction uses to mesh
+//! its implicit function, evaluating only the cells the surface crosses).
 //!
 //! Every cube is split the same way (Kuhn), vertices sit on grid edges and diagonals where the
 //! function changes sign, and each such vertex is shared by every tetrahedron around its edge:
@@ -36,7 +38,7 @@ const MIN_EDGE_FRACTION: f32 = 1e-3;
 
 /// Where along an edge from value `fa` to value `fb` (of opposite signs) the zero lies, in
 /// `(0, 1)`, kept away from the ends.
-pub(crate) fn crossing_fraction(fa: f32, fb: f32) -> f32 {
+fn crossing_fraction(fa: f32, fb: f32) -> f32 {
     let t = fa / (fa - fb);
     let t = if t.is_finite() { t } else { 0.5 };
     t.clamp(MIN_EDGE_FRACTION, 1.0 - MIN_EDGE_FRACTION)
@@ -165,6 +167,14 @@ impl Grid {
         self.origin + self.cell * Vec3::new(i as f32, j as f32, k as f32)
     }
 
+    /// The vertex on the grid edge or diagonal from point `a` to point `b`, whose values `fa` and
+    /// `fb` have opposite signs.
+    fn crossing(&self, a: [u32; 3], b: [u32; 3], fa: f32, fb: f32) -> Vec3 {
+        let t = crossing_fraction(fa, fb);
+        let (pa, pb) = (self.point(a), self.point(b));
+        pa + (pb - pa) * t
+    }
+
     fn on_border(&self, [i, j, k]: [u32; 3]) -> bool {
         i == 0 || j == 0 || k == 0 || i + 1 >= self.dims[0] || j + 1 >= self.dims[1] || k + 1 >= self.dims[2]
     }
@@ -174,6 +184,145 @@ impl Grid {
         let q = ((p - self.origin) / self.cell).floor();
         [0, 1, 2].map(|a| (q[a].max(0.0) as u32).min(self.dims[a].saturating_sub(2)))
     }
+}
+
+/// Values, crossing edges and vertex numbers at every point of a grid, for [`polygonise_grid`].
+struct Sampled {
+    /// Points per axis.
+    dims: [usize; 3],
+    /// `f` at every point, x fastest.
+    values: Vec<f32>,
+    /// Bit `d - 1` set when the edge from this point to the point offset by corner `d`
+    /// (bits x = 1, y = 2, z = 4) crosses the surface.
+    crossings: Vec<u8>,
+    /// Index of the vertex on this point's first crossing edge.
+    first_vertex: Vec<u32>,
+}
+
+impl Sampled {
+    fn point_index(&self, i: usize, j: usize, k: usize) -> usize {
+        i + self.dims[0] * (j + self.dims[1] * k)
+    }
+
+    /// Index offset of corner `c` (bits x = 1, y = 2, z = 4) from corner 0.
+    fn corner_offset(&self, c: u8) -> usize {
+        self.point_index(usize::from(c & 1), usize::from((c >> 1) & 1), usize::from((c >> 2) & 1))
+    }
+
+    /// Vertex on the crossing edge from point `p` to the point offset by corner `d` (d > 0).
+    fn vertex(&self, p: usize, d: u8) -> u32 {
+        let below = (1u8 << (d - 1)) - 1;
+        self.first_vertex[p] + (self.crossings[p] & below).count_ones()
+    }
+}
+
+/// Polygonises the zero set of `f` (negative inside) over the whole of `grid`, evaluating `f`
+/// at every point: every component is found without seeds, and where the surface leaves the
+/// grid it has a boundary. NaN counts as outside (the largest positive value), and so does 0.
+/// Vertices are numbered by grid point (x fastest) and then by the corner their edge goes to;
+/// triangles come cell by cell in the same order.
+///
+/// Evaluation and triangulation run in parallel over z-slabs; the output is the same for any
+/// number of threads. A grid with fewer than 2 points along an axis gives an empty mesh.
+pub(crate) fn polygonise_grid(f: impl Fn(Vec3) -> f32 + Sync, grid: &Grid) -> Mesh {
+    if grid.dims.iter().any(|&d| d < 2) {
+        return Mesh::default();
+    }
+    let dims = grid.dims.map(|d| d as usize);
+    let at = |i: usize, j: usize, k: usize| [i as u32, j as u32, k as u32];
+    let plane = dims[0] * dims[1];
+    let mut sampled = Sampled {
+        dims,
+        values: vec![0.0; plane * dims[2]],
+        crossings: vec![0; plane * dims[2]],
+        first_vertex: vec![0; plane * dims[2]],
+    };
+
+    // 1. Sample f; NaN becomes the largest positive value (outside).
+    let values: Vec<Vec<f32>> = (0..dims[2])
+        .into_par_iter()
+        .map(|k| {
+            let mut out = Vec::with_capacity(plane);
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let v = f(grid.point(at(i, j, k)));
+                    out.push(if v.is_nan() { f32::MAX } else { v });
+                }
+            }
+            out
+        })
+        .collect();
+    for (k, slab) in values.into_iter().enumerate() {
+        sampled.values[k * plane..(k + 1) * plane].copy_from_slice(&slab);
+    }
+
+    // 2. Per plane of points: crossing edges, plane-local vertex numbers and vertex positions.
+    let sampled_ref = &sampled;
+    let planes: Vec<(Vec<u8>, Vec<u32>, Vec<Vec3>)> = (0..dims[2])
+        .into_par_iter()
+        .map(|k| {
+            let mut crossings = Vec::with_capacity(plane);
+            let mut first = Vec::with_capacity(plane);
+            let mut positions = Vec::new();
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let fp = sampled_ref.values[sampled_ref.point_index(i, j, k)];
+                    let mut bits = 0u8;
+                    first.push(positions.len() as u32);
+                    for d in 1u8..8 {
+                        let (di, dj, dk) = (usize::from(d & 1), usize::from((d >> 1) & 1), usize::from((d >> 2) & 1));
+                        if i + di >= dims[0] || j + dj >= dims[1] || k + dk >= dims[2] {
+                            continue;
+                        }
+                        let fq = sampled_ref.values[sampled_ref.point_index(i + di, j + dj, k + dk)];
+                        if (fp < 0.0) == (fq < 0.0) {
+                            continue;
+                        }
+                        bits |= 1 << (d - 1);
+                        positions.push(grid.crossing(at(i, j, k), at(i + di, j + dj, k + dk), fp, fq));
+                    }
+                    crossings.push(bits);
+                }
+            }
+            (crossings, first, positions)
+        })
+        .collect();
+    let mut positions = Vec::with_capacity(planes.iter().map(|p| p.2.len()).sum());
+    for (k, (crossings, first, plane_positions)) in planes.into_iter().enumerate() {
+        let offset = positions.len() as u32;
+        sampled.crossings[k * plane..(k + 1) * plane].copy_from_slice(&crossings);
+        for (dst, src) in sampled.first_vertex[k * plane..(k + 1) * plane].iter_mut().zip(first) {
+            *dst = src + offset;
+        }
+        positions.extend(plane_positions);
+    }
+
+    // 3. Triangles, per slab of cells, concatenated in slab order.
+    let sampled = &sampled;
+    let positions_ref = &positions;
+    let slabs: Vec<Vec<[u32; 3]>> = (0..dims[2] - 1)
+        .into_par_iter()
+        .map(|k| {
+            let mut triangles = Vec::new();
+            for j in 0..dims[1] - 1 {
+                for i in 0..dims[0] - 1 {
+                    let base = sampled.point_index(i, j, k);
+                    let inside: [bool; 8] =
+                        std::array::from_fn(|c| sampled.values[base + sampled.corner_offset(c as u8)] < 0.0);
+                    cube_triangles(
+                        &inside,
+                        |lower, upper| {
+                            let v = sampled.vertex(base + sampled.corner_offset(lower), upper ^ lower);
+                            (v, positions_ref[v as usize])
+                        },
+                        &mut triangles,
+                    );
+                }
+            }
+            triangles
+        })
+        .collect();
+    Mesh::new(positions, None, slabs.concat())
 }
 
 /// A fast hasher for the packed grid keys (multiplicative, like FxHash, rotated at the end).
@@ -248,9 +397,7 @@ fn triangulate_cells(cells: &[u64], grid: &Grid, values: &FastMap<u64, f32>) -> 
             &inside,
             |lower, upper| {
                 let (a, b) = (corner(cell, lower), corner(cell, upper));
-                let t = crossing_fraction(corner_values[lower as usize], corner_values[upper as usize]);
-                let (pa, pb) = (grid.point(a), grid.point(b));
-                let p = pa + (pb - pa) * t;
+                let p = grid.crossing(a, b, corner_values[lower as usize], corner_values[upper as usize]);
                 edges.push(((Grid::key(a[0], a[1], a[2]), upper ^ lower), p));
                 ((edges.len() - 1) as u32, p)
             },

@@ -6,7 +6,7 @@
 //! of threads.
 
 use crate::mesh::Mesh;
-use crate::polygonise;
+use crate::polygonise::{polygonise_grid, Grid};
 use crate::rng::{stream_seed, Rng};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -214,44 +214,6 @@ pub fn genus_n_pretzel(n: u32) -> Mesh {
     implicit_mesh(f, -max, max, resolution)
 }
 
-/// The sampled grid of [`implicit_mesh`]: values at the points and, per point, the crossing
-/// edges that start there and the index of the first vertex on them.
-struct Grid {
-    /// Points per axis.
-    dims: [usize; 3],
-    /// Grid origin and cell size.
-    origin: Vec3,
-    cell: f32,
-    /// `f` at every point, x fastest.
-    values: Vec<f32>,
-    /// Bit `d - 1` set when the edge from this point to the point offset by corner `d`
-    /// (bits x = 1, y = 2, z = 4) crosses the surface.
-    crossings: Vec<u8>,
-    /// Index of the vertex on this point's first crossing edge.
-    first_vertex: Vec<u32>,
-}
-
-impl Grid {
-    fn point_index(&self, i: usize, j: usize, k: usize) -> usize {
-        i + self.dims[0] * (j + self.dims[1] * k)
-    }
-
-    fn point(&self, i: usize, j: usize, k: usize) -> Vec3 {
-        self.origin + self.cell * Vec3::new(i as f32, j as f32, k as f32)
-    }
-
-    /// Index offset of corner `c` (bits x = 1, y = 2, z = 4) from corner 0.
-    fn corner_offset(&self, c: u8) -> usize {
-        self.point_index(usize::from(c & 1), usize::from((c >> 1) & 1), usize::from((c >> 2) & 1))
-    }
-
-    /// Vertex on the crossing edge from point `p` to the point offset by corner `d` (d > 0).
-    fn vertex(&self, p: usize, d: u8) -> u32 {
-        let below = (1u8 << (d - 1)) - 1;
-        self.first_vertex[p] + (self.crossings[p] & below).count_ones()
-    }
-}
-
 /// Polygonises the zero set of `f` (negative inside, positive outside) in the box
 /// `[min, max]` by marching tetrahedra.
 ///
@@ -275,115 +237,15 @@ pub fn implicit_mesh(f: impl Fn(Vec3) -> f32 + Sync, min: Vec3, max: Vec3, resol
     }
     let resolution = resolution.clamp(1, MAX_RESOLUTION);
     let cell = longest / resolution as f32;
-    let cells_along = |e: f32| ((e / cell).ceil() as usize).clamp(1, resolution as usize);
+    let cells_along = |e: f32| ((e / cell).ceil() as u32).clamp(1, resolution);
     let dims = [cells_along(extent.x) + 1, cells_along(extent.y) + 1, cells_along(extent.z) + 1];
-    let plane = dims[0] * dims[1];
-    let mut grid = Grid {
-        dims,
-        origin: lo,
-        cell,
-        values: vec![0.0; plane * dims[2]],
-        crossings: vec![0; plane * dims[2]],
-        first_vertex: vec![0; plane * dims[2]],
-    };
+    let grid = Grid { origin: lo, cell, dims };
+    let mut mesh = polygonise_grid(&f, &grid);
 
-    // 1. Sample f; NaN becomes the largest positive value (outside).
-    let grid_ref = &grid;
-    let values: Vec<Vec<f32>> = (0..dims[2])
-        .into_par_iter()
-        .map(|k| {
-            let mut out = Vec::with_capacity(plane);
-            for j in 0..dims[1] {
-                for i in 0..dims[0] {
-                    let v = f(grid_ref.point(i, j, k));
-                    out.push(if v.is_nan() { f32::MAX } else { v });
-                }
-            }
-            out
-        })
-        .collect();
-    for (k, slab) in values.into_iter().enumerate() {
-        grid.values[k * plane..(k + 1) * plane].copy_from_slice(&slab);
-    }
-
-    // 2. Per plane of points: crossing edges, plane-local vertex numbers and vertex positions.
-    let grid_ref = &grid;
-    let planes: Vec<(Vec<u8>, Vec<u32>, Vec<Vec3>)> = (0..dims[2])
-        .into_par_iter()
-        .map(|k| {
-            let mut crossings = Vec::with_capacity(plane);
-            let mut first = Vec::with_capacity(plane);
-            let mut positions = Vec::new();
-            for j in 0..dims[1] {
-                for i in 0..dims[0] {
-                    let p = grid_ref.point_index(i, j, k);
-                    let fp = grid_ref.values[p];
-                    let mut bits = 0u8;
-                    first.push(positions.len() as u32);
-                    for d in 1u8..8 {
-                        let (di, dj, dk) = (usize::from(d & 1), usize::from((d >> 1) & 1), usize::from((d >> 2) & 1));
-                        if i + di >= dims[0] || j + dj >= dims[1] || k + dk >= dims[2] {
-                            continue;
-                        }
-                        let fq = grid_ref.values[grid_ref.point_index(i + di, j + dj, k + dk)];
-                        if (fp < 0.0) == (fq < 0.0) {
-                            continue;
-                        }
-                        bits |= 1 << (d - 1);
-                        let t = polygonise::crossing_fraction(fp, fq);
-                        let a = grid_ref.point(i, j, k);
-                        let b = grid_ref.point(i + di, j + dj, k + dk);
-                        positions.push(a + (b - a) * t);
-                    }
-                    crossings.push(bits);
-                }
-            }
-            (crossings, first, positions)
-        })
-        .collect();
-    let mut positions = Vec::with_capacity(planes.iter().map(|p| p.2.len()).sum());
-    for (k, (crossings, first, plane_positions)) in planes.into_iter().enumerate() {
-        let offset = positions.len() as u32;
-        grid.crossings[k * plane..(k + 1) * plane].copy_from_slice(&crossings);
-        for (dst, src) in grid.first_vertex[k * plane..(k + 1) * plane].iter_mut().zip(first) {
-            *dst = src + offset;
-        }
-        positions.extend(plane_positions);
-    }
-
-    // 3. Triangles, per slab of cells, concatenated in slab order.
-    let grid = &grid;
-    let positions_ref = &positions;
-    let slabs: Vec<Vec<[u32; 3]>> = (0..dims[2] - 1)
-        .into_par_iter()
-        .map(|k| {
-            let mut triangles = Vec::new();
-            for j in 0..dims[1] - 1 {
-                for i in 0..dims[0] - 1 {
-                    let base = grid.point_index(i, j, k);
-                    let inside: [bool; 8] =
-                        std::array::from_fn(|c| grid.values[base + grid.corner_offset(c as u8)] < 0.0);
-                    if inside.iter().all(|&x| x == inside[0]) {
-                        continue;
-                    }
-                    polygonise::cube_triangles(
-                        &inside,
-                        |lower, upper| {
-                            let v = grid.vertex(base + grid.corner_offset(lower), upper ^ lower);
-                            (v, positions_ref[v as usize])
-                        },
-                        &mut triangles,
-                    );
-                }
-            }
-            triangles
-        })
-        .collect();
-    let triangles: Vec<[u32; 3]> = slabs.concat();
-
-    // 4. Normals from the gradient; where it vanishes, from the faces.
+    // Normals from the gradient; where it vanishes, from the faces.
     let step = cell * 0.1;
-    let mut normals: Vec<Vec3> = positions
+    let mut normals: Vec<Vec3> = mesh
+        .positions
         .par_iter()
         .map(|&p| {
             let g = Vec3::new(
@@ -394,7 +256,6 @@ pub fn implicit_mesh(f: impl Fn(Vec3) -> f32 + Sync, min: Vec3, max: Vec3, resol
             g.normalize_or_zero()
         })
         .collect();
-    let mut mesh = Mesh::new(positions, None, triangles);
     if normals.contains(&Vec3::ZERO) {
         let fallback = mesh.area_weighted_normals();
         for (n, alt) in normals.iter_mut().zip(fallback) {

@@ -7,6 +7,7 @@
 //! fraction of a second.
 
 use crate::mesh::Mesh;
+use crate::union_find::UnionFind;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -74,39 +75,6 @@ impl TopologyReport {
             total = total.checked_add(u32::try_from((2 - chi) / 2).ok()?)?;
         }
         Some(total)
-    }
-}
-
-/// Disjoint-set forest over `0..n` with path halving and union by size.
-struct UnionFind {
-    parent: Vec<u32>,
-    size: Vec<u32>,
-}
-
-impl UnionFind {
-    fn new(n: usize) -> UnionFind {
-        UnionFind { parent: (0..n as u32).collect(), size: vec![1; n] }
-    }
-
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.parent[x as usize] != x {
-            let grand = self.parent[self.parent[x as usize] as usize];
-            self.parent[x as usize] = grand;
-            x = grand;
-        }
-        x
-    }
-
-    fn union(&mut self, a: u32, b: u32) {
-        let (mut a, mut b) = (self.find(a), self.find(b));
-        if a == b {
-            return;
-        }
-        if self.size[a as usize] < self.size[b as usize] {
-            std::mem::swap(&mut a, &mut b);
-        }
-        self.parent[b as usize] = a;
-        self.size[a as usize] += self.size[b as usize];
     }
 }
 
