@@ -26,7 +26,7 @@ use vstree::ffi::mesh::*;
 use vstree::ffi::simplify::*;
 use vstree::ffi::vstree_status;
 use vstree::simplify::{simplify, SimplifyParams};
-use vstree::{shapes, Progress, TreeParams};
+use vstree::{eval::shapes, Progress, TreeParams};
 
 const RUNS: usize = 15;
 /// The L2 error settings measured: the default (coarse) to fine.

@@ -19,7 +19,7 @@ one tab-separated line per method on stdout:
 tiny target).
 
 The Rust bench reads the outputs back and measures their distance to the input with
-`vstree::distance`, so every row of the table uses one metric. Only the filter call is timed
+`vstree::eval::distance`, so every row of the table uses one metric. Only the filter call is timed
 (the mesh is already in memory), as for the Rust side. Diagnostics go to stderr.
 
 Methods: `meshlab-clustering`, `meshlab-qec` (the default pair), `meshopt-simplify`,

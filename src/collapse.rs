@@ -440,7 +440,7 @@ fn border_vertices(mesh: &Mesh, head: &[u32], next: &[u32]) -> Vec<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shapes;
+    use crate::eval::shapes;
 
     /// The border by the definition: vertices of an edge (a, b) that one face-side has, every
     /// triangle's three sides counted, found by sorting them all.

@@ -274,7 +274,7 @@ impl Decimator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shapes;
+    use crate::eval::shapes;
     use crate::topology::analyze;
 
     /// Each vertex's quadric: the planes of its faces (unit normals, as samples would give).

@@ -7,8 +7,8 @@
 
 mod collapse;
 mod decimate;
-pub mod distance;
 pub mod error;
+pub mod eval;
 pub mod ffi;
 pub mod io;
 mod linalg;
@@ -20,7 +20,6 @@ pub mod quadric;
 pub mod reconstruct;
 pub mod rng;
 pub mod samples;
-pub mod shapes;
 pub mod simplify;
 pub mod spatial;
 pub mod topology;

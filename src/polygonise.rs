@@ -1,6 +1,6 @@
 //! Marching tetrahedra of an implicit function over a regular grid, in two ways that share the
 //! grid, the vertex placement and the per-cube triangulation: densely over the whole grid
-//! ([`polygonise_grid`], for generated shapes, [`crate::shapes::implicit_mesh`]), and by
+//! ([`polygonise_grid`], for generated shapes, [`crate::eval::shapes::implicit_mesh`]), and by
 //! tracking the surface from seed cells ([`track_surface`], which reconstruction uses to mesh
 //! its implicit function, evaluating only the cells the surface crosses).
 //!
@@ -522,7 +522,8 @@ pub(crate) fn track_surface(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::topology::{analyze, signed_volume};
+    use crate::eval::figures::signed_volume;
+    use crate::topology::analyze;
 
     #[test]
     fn kuhn_tets_are_paths_with_the_stated_orientation() {
@@ -557,7 +558,7 @@ mod tests {
         let exact = 2.0 * std::f64::consts::PI.powi(2) * 1.0 * 0.35f64.powi(2);
         assert!((volume / exact - 1.0).abs() < 0.02, "volume {volume} vs {exact}");
         // Same mesh as the dense polygoniser on the same grid.
-        let dense = crate::shapes::implicit_mesh(torus, grid.origin, grid.origin + grid.cell * 64.0, 64);
+        let dense = crate::eval::shapes::implicit_mesh(torus, grid.origin, grid.origin + grid.cell * 64.0, 64);
         assert_eq!(dense.triangles.len(), mesh.triangles.len());
     }
 

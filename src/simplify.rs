@@ -525,7 +525,7 @@ mod tests {
         // The seed only sets where the tree's growth starts: below it (1e-1, coarser) the seed
         // is SEED_ERROR, above it (1e-5) the finer tree is cut; the output is the same.
         assert_eq!(SEED_ERROR, 1e-2);
-        let mesh = crate::shapes::torus(1.0, 0.3, 96, 48);
+        let mesh = crate::eval::shapes::torus(1.0, 0.3, 96, 48);
         let run = |error| {
             let tree = TreeParams { error, ..TreeParams::default() };
             let params = SimplifyParams { tree, target_faces: 600, ..Default::default() };
@@ -544,15 +544,15 @@ mod tests {
         // that take it to the size choose the vertices to remove by what they cost, and the
         // surface stays closer: mean distance 0.0134 against 0.0222 (0.0161 with twice as
         // many, 0.0143 with eight times).
-        let torus = crate::shapes::torus(1.0, 0.3, 192, 96);
+        let torus = crate::eval::shapes::torus(1.0, 0.3, 192, 96);
         let params = SimplifyParams { target_faces: 300, keep_topology: KeepTopology::On, ..Default::default() };
         let threads = Threads::new(1).unwrap();
         let distance = |factor| {
             let (out, _) = simplify_to_size(&torus, &params, true, factor, &threads, &mut Progress::none()).unwrap();
             assert!(out.triangles.len().abs_diff(300) <= 1);
             assert_eq!(analyze(&out).genus(), Some(1));
-            let on_output = crate::shapes::sample_surface(&out, 20_000, 1).positions;
-            crate::distance::one_sided(&on_output, crate::distance::Target::Triangles(&torus)).mean
+            let on_output = crate::eval::shapes::sample_surface(&out, 20_000, 1).positions;
+            crate::eval::distance::one_sided(&on_output, crate::eval::distance::Target::Triangles(&torus)).mean
         };
         let (one, more) = (distance(1.0), distance(CLUSTER_FACTOR));
         assert!(more < 0.7 * one, "{more} against {one}");
@@ -562,7 +562,8 @@ mod tests {
     fn one_round_suffices_on_closed_shapes() {
         // The margin is meant to make the first round give enough triangles: on these shapes,
         // the clustering of the first round's clusters already has the target's count.
-        for (mesh, target) in [(crate::shapes::icosphere(1.0, 5), 2000), (crate::shapes::torus(1.0, 0.3, 192, 96), 700)]
+        for (mesh, target) in
+            [(crate::eval::shapes::icosphere(1.0, 5), 2000), (crate::eval::shapes::torus(1.0, 0.3, 192, 96), 700)]
         {
             let samples = SampleSet::from_mesh(&mesh, MeshSampling::Vertices).unwrap();
             let threads = Threads::new(1).unwrap();

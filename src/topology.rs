@@ -1,10 +1,10 @@
-//! Topology figures of a triangle mesh: counts, manifoldness, orientation, components, Euler
-//! characteristic and genus, so that tests can assert that a surface is watertight and has the
-//! expected genus (and fail when it is not).
+//! The connectivity of a triangle mesh: counts, manifoldness, orientation, components, Euler
+//! characteristic and genus ([`analyze`]), which the simplifier's topology guard, the
+//! reconstruction and the tests all rely on, and the edge walks the reconstruction makes (its
+//! edges, border vertices and the pairs of faces across each edge).
 //!
-//! Everything here is combinatorial except [`signed_volume`] and [`surface_area`]. The edge
-//! analysis sorts the 3F half-edges by their undirected key, so a million triangles take a
-//! fraction of a second.
+//! The edge analysis sorts the 3F half-edges by their undirected key, so a million triangles
+//! take a fraction of a second.
 
 use crate::mesh::Mesh;
 use crate::union_find::UnionFind;
@@ -79,7 +79,7 @@ impl TopologyReport {
 }
 
 /// True when `tri` has three distinct indices below `vertex_count`.
-fn is_valid_face(tri: &[u32; 3], vertex_count: usize) -> bool {
+pub(crate) fn is_valid_face(tri: &[u32; 3], vertex_count: usize) -> bool {
     tri.iter().all(|&v| (v as usize) < vertex_count) && tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2]
 }
 
@@ -325,73 +325,16 @@ pub fn folded_face_pairs(
         .collect()
 }
 
-/// The valence (number of distinct neighbours along edges) of every vertex in `positions`;
-/// unreferenced vertices have valence 0. Degenerate faces are ignored.
-pub fn valences(mesh: &Mesh) -> Vec<u32> {
-    let faces: Vec<[u32; 3]> =
-        mesh.triangles.iter().filter(|tri| is_valid_face(tri, mesh.positions.len())).copied().collect();
-    let mut valence = vec![0u32; mesh.positions.len()];
-    for run in sorted_half_edges(&faces).chunk_by(|a, b| a.key == b.key) {
-        valence[(run[0].key >> 32) as usize] += 1;
-        valence[(run[0].key & 0xFFFF_FFFF) as usize] += 1;
-    }
-    valence
-}
-
-/// `histogram[k]` = the number of referenced vertices with valence k (unreferenced vertices, of
-/// valence 0, are not counted). Empty for a mesh without faces.
-pub fn valence_histogram(mesh: &Mesh) -> Vec<u32> {
-    let mut histogram: Vec<u32> = Vec::new();
-    for v in valences(mesh).into_iter().filter(|&v| v > 0) {
-        if histogram.len() <= v as usize {
-            histogram.resize(v as usize + 1, 0);
-        }
-        histogram[v as usize] += 1;
-    }
-    histogram
-}
-
-/// The signed volume enclosed by the triangles (sum of the signed tetrahedra from the origin), in
-/// double precision. Positive for a closed mesh with outward (counter-clockwise seen from
-/// outside) winding. Faces with out-of-range indices are skipped.
-pub fn signed_volume(mesh: &Mesh) -> f64 {
-    let p = &mesh.positions;
-    mesh.triangles
-        .iter()
-        .filter(|tri| tri.iter().all(|&v| (v as usize) < p.len()))
-        .map(|&[a, b, c]| {
-            let (a, b, c) = (p[a as usize].as_dvec3(), p[b as usize].as_dvec3(), p[c as usize].as_dvec3());
-            a.dot(b.cross(c))
-        })
-        .sum::<f64>()
-        / 6.0
-}
-
-/// The total area of the triangles, in double precision. Faces with out-of-range indices are
-/// skipped.
-pub fn surface_area(mesh: &Mesh) -> f64 {
-    let p = &mesh.positions;
-    mesh.triangles
-        .iter()
-        .filter(|tri| tri.iter().all(|&v| (v as usize) < p.len()))
-        .map(|&[a, b, c]| {
-            let a = p[a as usize].as_dvec3();
-            (p[b as usize].as_dvec3() - a).cross(p[c as usize].as_dvec3() - a).length()
-        })
-        .sum::<f64>()
-        / 2.0
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn border_vertices_are_those_of_the_edges_one_face_has() {
-        let sphere = crate::shapes::icosphere(1.0, 2);
+        let sphere = crate::eval::shapes::icosphere(1.0, 2);
         assert!(!border_vertices(&sphere.triangles, sphere.positions.len()).contains(&true));
         // A 4 x 4 grid of squares: the 16 vertices round its edge, not the 9 inside.
-        let grid = crate::shapes::square_grid(4);
+        let grid = crate::eval::shapes::square_grid(4);
         let border = border_vertices(&grid.triangles, grid.positions.len());
         assert_eq!(border.iter().filter(|&&b| b).count(), 16);
         for (v, p) in grid.positions.iter().enumerate() {
@@ -425,7 +368,7 @@ mod tests {
 
     #[test]
     fn closed_surface_genus_agrees_with_the_full_analysis() {
-        use crate::shapes;
+        use crate::eval::shapes;
         let mut two_shapes = shapes::torus(1.0, 0.3, 24, 12);
         let double = shapes::double_torus();
         let offset = two_shapes.positions.len() as u32;
@@ -450,9 +393,6 @@ mod tests {
         assert_eq!(r.euler_characteristic, 2);
         assert!(r.is_watertight(), "{r:?}");
         assert_eq!(r.genus(), Some(0));
-        assert!((signed_volume(&m) - 1.0 / 6.0).abs() < 1e-12);
-        assert_eq!(valences(&m), vec![3, 3, 3, 3]);
-        assert_eq!(valence_histogram(&m), vec![0, 0, 0, 4]);
     }
 
     #[test]
@@ -503,7 +443,5 @@ mod tests {
         let cloud = Mesh::from_points(vec![Vec3::ONE; 3], None);
         let r = analyze(&cloud);
         assert_eq!((r.faces, r.unreferenced_vertices), (0, 3));
-        assert_eq!(signed_volume(&cloud), 0.0);
-        assert!(valence_histogram(&cloud).is_empty());
     }
 }

@@ -152,7 +152,7 @@ fn absurd_parameters_are_refused_by_name() {
 
 #[test]
 fn cancelling_stops_with_cancelled() {
-    let mesh = vstree::shapes::icosphere(1.0, 5);
+    let mesh = vstree::eval::shapes::icosphere(1.0, 5);
     let mut stop = |_: f32, _: &str| false;
     let result = simplify(&mesh, &SimplifyParams::default(), &mut Progress::new(&mut stop));
     assert!(matches!(result, Err(Error::Cancelled)));
@@ -167,7 +167,7 @@ fn a_mesh_with_a_non_finite_origin_is_refused() {
 
 #[test]
 fn targets_the_input_cannot_give_are_refused_or_give_the_nearest_mesh() {
-    let sphere = vstree::shapes::icosphere(1.0, 3); // 1280 triangles
+    let sphere = vstree::eval::shapes::icosphere(1.0, 3); // 1280 triangles
     let with = |mesh: &Mesh, target_faces| {
         simplify(mesh, &SimplifyParams { target_faces, ..Default::default() }, &mut Progress::none())
     };

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 use std::process::Command;
-use vstree::{io, shapes};
+use vstree::{eval::shapes, io};
 
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("vstree-cli-{name}-{}", std::process::id()));

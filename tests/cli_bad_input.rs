@@ -9,7 +9,7 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-use vstree::{io, shapes, Mesh};
+use vstree::{eval::shapes, io, Mesh};
 
 /// Longer than any case needs; a case still running then is a hang.
 const TIMEOUT: Duration = Duration::from_secs(10);

@@ -9,7 +9,7 @@ use glam::{DVec3, Vec3};
 use std::fmt::Write as _;
 use std::path::Path;
 use vstree::reconstruct::{reconstruct, ReconstructParams};
-use vstree::{io, shapes, simplify, Mesh, Progress, SimplifyParams};
+use vstree::{eval::shapes, io, simplify, Mesh, Progress, SimplifyParams};
 
 /// `mesh` moved by `offset`, written as text in f64 the way a georeferencing tool would, and
 /// read back: an XYZ file for a cloud, an ASCII PLY for a mesh.

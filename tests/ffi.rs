@@ -11,7 +11,7 @@ use vstree::ffi::tree::*;
 use vstree::ffi::*;
 use vstree::rng::Rng;
 use vstree::simplify::{simplify, SimplifyParams};
-use vstree::{shapes, Mesh, Progress};
+use vstree::{eval::shapes, Mesh, Progress};
 
 mod common;
 use common::ffi::{handle, last_error, read_back};

@@ -11,7 +11,7 @@ use vstree::ffi::reconstruct::*;
 use vstree::ffi::*;
 use vstree::normals::{ensure_normals, NormalParams, Orientation};
 use vstree::reconstruct::{reconstruct, ReconstructParams, RefinementStop};
-use vstree::{shapes, topology, Mesh, Progress};
+use vstree::{eval::shapes, topology, Mesh, Progress};
 
 mod common;
 use common::ffi::{handle, last_error, read_back};

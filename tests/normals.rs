@@ -4,9 +4,9 @@
 mod common;
 
 use glam::Vec3;
+use vstree::eval::shapes::{add_noise, icosphere, sample_surface, torus};
 use vstree::normals::{ensure_normals, estimate_normals, orient_normals, NormalParams, Orientation};
 use vstree::rng::Rng;
-use vstree::shapes::{add_noise, icosphere, sample_surface, torus};
 use vstree::{Error, Mesh, Progress};
 
 /// Fraction of `normals` within `degrees` of `truth` (signed: pointing the same way).

@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 use std::time::Instant;
+use vstree::eval::shapes::{bumpy_sphere, sample_surface};
 use vstree::normals::{estimate_normals, NormalParams};
-use vstree::shapes::{bumpy_sphere, sample_surface};
 use vstree::spatial::KdTree;
 use vstree::{Progress, Threads};
 

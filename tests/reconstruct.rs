@@ -4,10 +4,10 @@
 mod common;
 
 use glam::Vec3;
-use vstree::distance::chamfer_and_hausdorff;
+use vstree::eval::distance::chamfer_and_hausdorff;
 use vstree::reconstruct::{reconstruct, BaseMesh, Closure, ReconstructParams, ReconstructStats, RefinementStop};
 use vstree::tree::TreeParams;
-use vstree::{shapes, topology, Error, Mesh, Progress};
+use vstree::{eval::shapes, topology, Error, Mesh, Progress};
 
 fn run(cloud: &Mesh, params: &ReconstructParams) -> (Mesh, ReconstructStats) {
     reconstruct(cloud, params, &mut Progress::none()).unwrap()
@@ -15,7 +15,7 @@ fn run(cloud: &Mesh, params: &ReconstructParams) -> (Mesh, ReconstructStats) {
 
 /// Share of vertices with valence 6.
 fn regular_share(mesh: &Mesh) -> f64 {
-    let v = topology::valences(mesh);
+    let v = vstree::eval::figures::valences(mesh);
     v.iter().filter(|&&d| d == 6).count() as f64 / v.len() as f64
 }
 
@@ -271,7 +271,7 @@ fn a_cloud_without_normals_gets_them_estimated() {
     assert_eq!(stats.normals.estimated, 40_000);
     let report = topology::analyze(&mesh);
     assert!(report.is_watertight() && report.genus() == Some(1), "{report:?}");
-    assert!(topology::signed_volume(&mesh) > 0.0, "facing inward");
+    assert!(vstree::eval::figures::signed_volume(&mesh) > 0.0, "facing inward");
 }
 
 #[test]
@@ -300,7 +300,8 @@ fn a_single_range_scan_gives_an_open_mesh() {
     // specks of it, would leave thousands of border edges).
     assert!(report.boundary_edges < mesh.triangles.len() / 20, "{report:?}");
     // What is left is near the samples.
-    let far = vstree::distance::one_sided(&mesh.positions, vstree::distance::Target::Points(&scan.positions));
+    let far =
+        vstree::eval::distance::one_sided(&mesh.positions, vstree::eval::distance::Target::Points(&scan.positions));
     assert!(far.p99 < 0.01 * scan.bounds().unwrap().diagonal(), "p99 {}", far.p99);
     // Asked for, the same scan gives a closed surface.
     let (mesh, stats) = run(&scan, &ReconstructParams { closure: Closure::Closed, ..Default::default() });

@@ -4,13 +4,14 @@ mod common;
 
 use glam::Vec3;
 use std::path::Path;
-use vstree::distance::{chamfer_and_hausdorff, one_sided, point_to_mesh_distances, Target};
-use vstree::shapes::{
+use vstree::eval::distance::{chamfer_and_hausdorff, one_sided, point_to_mesh_distances, Target};
+use vstree::eval::figures::{signed_volume, surface_area, valence_histogram, valences};
+use vstree::eval::shapes::{
     add_noise, bumpy_radius, bumpy_sphere, double_torus, genus_n_pretzel, icosphere, implicit_mesh, sample_surface,
     torus,
 };
 use vstree::spatial::TriangleBvh;
-use vstree::topology::{analyze, signed_volume, surface_area, valence_histogram, valences};
+use vstree::topology::analyze;
 use vstree::Mesh;
 
 /// Asserts a closed, oriented, positive-volume surface of the given genus, one component, with

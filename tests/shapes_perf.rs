@@ -3,9 +3,9 @@
 
 use glam::Vec3;
 use std::time::Instant;
-use vstree::distance::{point_to_mesh_distances, point_to_points_distances};
+use vstree::eval::distance::{point_to_mesh_distances, point_to_points_distances};
+use vstree::eval::shapes::{add_noise, genus_n_pretzel, icosphere, sample_surface, torus};
 use vstree::rng::Rng;
-use vstree::shapes::{add_noise, genus_n_pretzel, icosphere, sample_surface, torus};
 use vstree::spatial::{KdTree, TriangleBvh};
 use vstree::topology::analyze;
 

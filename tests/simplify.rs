@@ -5,10 +5,10 @@ mod common;
 
 use glam::Vec3;
 use std::collections::HashSet;
-use vstree::distance::{one_sided, Target};
+use vstree::eval::distance::{one_sided, Target};
 use vstree::simplify::{simplify, SimplifyParams};
 use vstree::tree::{Metric, TreeKind, TreeParams};
-use vstree::{shapes, topology, Mesh, MeshSampling, Progress};
+use vstree::{eval::shapes, Mesh, MeshSampling, Progress};
 
 fn run(
     mesh: &Mesh,
@@ -76,8 +76,8 @@ fn sphere_simplifies_within_the_bound_keeping_orientation() {
             );
             assert_eq!(stats.output_vertices, out.positions.len());
             assert_within_bound("sphere", &sphere, &out, error);
-            let volume = topology::signed_volume(&out);
-            let expected = topology::signed_volume(&sphere);
+            let volume = vstree::eval::figures::signed_volume(&out);
+            let expected = vstree::eval::figures::signed_volume(&sphere);
             assert!(volume > 0.9 * expected, "{kind:?} {error}: volume {volume} vs {expected}: orientation lost?");
         }
     }

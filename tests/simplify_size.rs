@@ -4,7 +4,7 @@
 mod common;
 
 use vstree::topology::{analyze, TopologyReport};
-use vstree::{shapes, simplify, KeepTopology, Mesh, Progress, SimplifyParams, SimplifyStats};
+use vstree::{eval::shapes, simplify, KeepTopology, Mesh, Progress, SimplifyParams, SimplifyStats};
 
 fn to_size(mesh: &Mesh, target: usize, keep_topology: KeepTopology) -> (Mesh, SimplifyStats) {
     let params = SimplifyParams { target_faces: target, keep_topology, ..Default::default() };

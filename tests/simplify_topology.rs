@@ -5,7 +5,7 @@ mod common;
 
 use vstree::topology::analyze;
 use vstree::tree::TreeParams;
-use vstree::{shapes, simplify, Mesh, Progress, SimplifyParams};
+use vstree::{eval::shapes, simplify, Mesh, Progress, SimplifyParams};
 
 fn simplified(mesh: &Mesh, error: f64, keep_topology: bool) -> Mesh {
     let keep_topology = if keep_topology { vstree::KeepTopology::On } else { vstree::KeepTopology::Off };

@@ -2,7 +2,7 @@
 
 mod common;
 
-use vstree::shapes;
+use vstree::eval::shapes;
 use vstree::tree::{self, Metric, NodeKind, TreeKind, TreeParams};
 use vstree::{MeshSampling, Progress, SampleSet, Threads};
 

@@ -1,9 +1,9 @@
 //! Distances between an output mesh and its input, relative to the input's bounding-box
-//! diagonal, measured with `vstree::distance` the same way for every method.
+//! diagonal, measured with `vstree::eval::distance` the same way for every method.
 
 use glam::Vec3;
-use vstree::distance::{one_sided, Target};
-use vstree::shapes::sample_surface;
+use vstree::eval::distance::{one_sided, Target};
+use vstree::eval::shapes::sample_surface;
 use vstree::Mesh;
 
 /// Points sampled uniformly by area on an output's surface to measure its distance to the input.

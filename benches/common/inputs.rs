@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use std::path::Path;
-use vstree::{io, shapes, Mesh, MeshSampling, SampleSet};
+use vstree::{eval::shapes, io, Mesh, MeshSampling, SampleSet};
 
 /// Seed of the clouds drawn on a surface: every table draws the same points.
 const SEED: u64 = 2006;

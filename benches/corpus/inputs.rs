@@ -7,7 +7,7 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use vstree::shapes::{add_noise, icosphere, sample_surface};
+use vstree::eval::shapes::{add_noise, icosphere, sample_surface};
 use vstree::{io, topology, Mesh};
 
 /// The generalisation corpus (`corpus/README.md`): file, components, total genus.

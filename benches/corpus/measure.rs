@@ -7,7 +7,7 @@ use crate::common::reconstruction::smallest_angle;
 use crate::inputs::Truth;
 use glam::Vec3;
 use rayon::prelude::*;
-use vstree::distance::Target;
+use vstree::eval::distance::Target;
 use vstree::spatial::KdTree;
 use vstree::{topology, Mesh};
 
@@ -77,7 +77,7 @@ impl Samples {
 /// [`Quality`] of `output` (in the truth's frame) against `truth`; `samples` for open inputs.
 pub fn quality(output: &Mesh, truth: &Truth, samples: Option<&Samples>) -> Quality {
     let report = topology::analyze(output);
-    let used: Vec<u32> = topology::valences(output).into_iter().filter(|&v| v > 0).collect();
+    let used: Vec<u32> = vstree::eval::figures::valences(output).into_iter().filter(|&v| v > 0).collect();
     let six = used.iter().filter(|&&v| v == 6).count();
     let angles: Vec<f64> = output.triangles.par_iter().map(|t| smallest_angle(output, t)).collect();
     let share = |limit: f64| angles.iter().filter(|&&a| a < limit).count() as f64 / angles.len().max(1) as f64;

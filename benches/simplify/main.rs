@@ -5,7 +5,7 @@
 //! PyMeshLab (quadric edge collapse, clustering), run in the same session by
 //! `benches/peers.py`. Every output is measured here with the same code: triangles, time of the
 //! call alone (median of runs, mesh in memory, in process), Chamfer and Hausdorff distance to
-//! the input over its bounding-box diagonal (`vstree::distance`), non-manifold edges, and
+//! the input over its bounding-box diagonal (`vstree::eval::distance`), non-manifold edges, and
 //! whether a closed input's genus is kept (`vstree::topology::analyze`). Also error against
 //! size over a range of sizes for two models, drawn by `benches/simplify_plot.py` into
 //! `docs/images/`. Writes its report into `docs/benchmarks.md` between markers.
@@ -25,7 +25,7 @@ use common::stats::median;
 use report::{Context, Report, Row};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use vstree::distance::Target;
+use vstree::eval::distance::Target;
 use vstree::topology::analyze;
 use vstree::{io, simplify, KeepTopology, Mesh, MeshSampling, Progress, SampleSet, SimplifyParams, TreeKind};
 

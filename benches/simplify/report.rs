@@ -111,7 +111,7 @@ impl Report {
         let _ = writeln!(
             md,
             "- Times: median of {} runs of the call alone, the mesh already in memory, in process; vstree on {} \
-             (the new mode also on one thread), the peers on one. Distances: `vstree::distance`, relative to the \
+             (the new mode also on one thread), the peers on one. Distances: `vstree::eval::distance`, relative to the \
              input's bounding-box diagonal; Chamfer = mean of the two one-sided mean distances (200k points on the \
              output, the input's vertices), Hausdorff = the larger one-sided maximum.",
             c.runs,

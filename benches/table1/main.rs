@@ -201,7 +201,7 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
     }
     let mut sweep = Vec::new();
     if let Some(count) = o.sweep {
-        let sphere = vstree::shapes::icosphere(1.0, 6);
+        let sphere = vstree::eval::shapes::icosphere(1.0, 6);
         for (name, mesh) in [("sphere", &sphere), (surface_name.as_str(), &surface)] {
             let name = format!("{name} {}", common::inputs::short_count(count));
             eprintln!("table1: bound sweep on {name}");

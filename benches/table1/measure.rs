@@ -4,7 +4,7 @@ use crate::common::distance::{self, Distances};
 use crate::common::stats::median;
 use glam::Vec3;
 use std::time::Instant;
-use vstree::distance::Target;
+use vstree::eval::distance::Target;
 use vstree::tree::{self, NodeKind, TreeKind, TreeParams, TreeStats, VsTree};
 use vstree::{simplify, Mesh, MeshSampling, Progress, SampleSet, SimplifyParams, Threads};
 

@@ -5,7 +5,7 @@ use crate::common::distance::{between, Distances};
 use crate::common::reconstruction::smallest_angle;
 pub use crate::common::reconstruction::{reconstruction, Stages};
 use glam::Vec3;
-use vstree::distance::Target;
+use vstree::eval::distance::Target;
 use vstree::{topology, Mesh};
 
 /// Triangles whose smallest angle is below this many degrees count as badly shaped.
@@ -33,7 +33,7 @@ pub struct Quality {
 /// [`Quality`] of `mesh` against the input `points` (box diagonal `diagonal`).
 pub fn quality(mesh: &Mesh, points: &[Vec3], diagonal: f32) -> Quality {
     let report = topology::analyze(mesh);
-    let used: Vec<u32> = topology::valences(mesh).into_iter().filter(|&v| v > 0).collect();
+    let used: Vec<u32> = vstree::eval::figures::valences(mesh).into_iter().filter(|&v| v > 0).collect();
     let six = used.iter().filter(|&&v| v == 6).count();
     let small = mesh.triangles.iter().filter(|t| smallest_angle(mesh, t) < SMALL_ANGLE_DEGREES).count();
     Quality {

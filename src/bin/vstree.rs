@@ -614,7 +614,7 @@ fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &Reconstruct
 
 /// The `demo` job: both algorithms on generated shapes whose answers are known.
 fn demo(out: &Path) -> vstree::Result<()> {
-    use vstree::{shapes, topology};
+    use vstree::{eval::shapes, topology};
     if out.exists() && !out.is_dir() {
         let e = std::io::Error::new(
             std::io::ErrorKind::AlreadyExists,

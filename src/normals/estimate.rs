@@ -3,9 +3,9 @@
 //! neighbourhood spans a plane and tells a flat cloud from a solid one.
 
 use crate::error::{Error, Result};
-use crate::spatial::KdTree;
 use crate::linalg::Sym3;
 use crate::progress::{Progress, Threads};
+use crate::spatial::KdTree;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 

@@ -156,9 +156,9 @@ mod tests {
     #[test]
     fn collapsing_keeps_the_genus() {
         for (mesh, genus) in [
-            (crate::shapes::icosphere(1.0, 3), 0),
-            (crate::shapes::torus(1.0, 0.4, 48, 24), 1),
-            (crate::shapes::double_torus(), 2),
+            (crate::eval::shapes::icosphere(1.0, 3), 0),
+            (crate::eval::shapes::torus(1.0, 0.4, 48, 24), 1),
+            (crate::eval::shapes::double_torus(), 2),
         ] {
             // Eight clusters, the octants: collapse as far as topology allows.
             let base = cluster_at_t_layer(
@@ -179,7 +179,7 @@ mod tests {
     fn an_open_mesh_collapses_along_its_border() {
         // The upper half of a sphere in four clusters (the quadrants around z): a few vertices
         // each, and the border stays one manifold loop.
-        let sphere = crate::shapes::icosphere(1.0, 4);
+        let sphere = crate::eval::shapes::icosphere(1.0, 4);
         let upper = sphere
             .triangles
             .iter()
@@ -208,7 +208,7 @@ mod tests {
         // strip's border (a side and two bits of the others) shrinks to one vertex at its
         // mean, cutting the square's corners off; with runs of at most 0.3, every corner
         // stays within 0.3 of an M0 vertex.
-        let mesh = crate::shapes::square_grid(20);
+        let mesh = crate::eval::shapes::square_grid(20);
         let labels: Vec<u32> = mesh.positions.iter().map(|p| ((4.0 * p.x) as u32).min(3)).collect();
         let rows = Rows::neighbours(&mesh.triangles, mesh.positions.len());
         let corner_gap = |base: &BaseMesh| {
@@ -228,7 +228,7 @@ mod tests {
 
     #[test]
     fn components_spanning_fewer_than_four_t_nodes_are_dropped() {
-        let mesh = crate::shapes::icosphere(1.0, 2);
+        let mesh = crate::eval::shapes::icosphere(1.0, 2);
         let base = cluster_at_t_layer(
             &mesh,
             &vec![0; mesh.positions.len()],
@@ -241,7 +241,7 @@ mod tests {
 
     #[test]
     fn labels_partition_a_sphere_into_clusters() {
-        let mesh = crate::shapes::icosphere(1.0, 4);
+        let mesh = crate::eval::shapes::icosphere(1.0, 4);
         // Eight clusters: the octants.
         let base = cluster_at_t_layer(
             &mesh,

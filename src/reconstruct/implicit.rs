@@ -107,7 +107,7 @@ mod tests {
 
     #[test]
     fn blended_planes_of_a_sphere_approximate_its_signed_distance() {
-        let cloud = crate::shapes::sample_surface(&crate::shapes::icosphere(1.0, 5), 50_000, 1);
+        let cloud = crate::eval::shapes::sample_surface(&crate::eval::shapes::icosphere(1.0, 5), 50_000, 1);
         let positions: Vec<Vec3> = cloud.positions.iter().map(|p| p.normalize()).collect();
         let samples = SampleSet { normals: positions.clone(), origin: (0..50_000).collect(), positions };
         let t = tree::build(

@@ -285,7 +285,7 @@ pub(crate) mod tests {
     /// An icosphere on sphere samples with three vertices slid along the sphere past their
     /// whole ring, so triangles around them face inward; normals radial.
     fn pushed_icosphere() -> Surface {
-        let sphere = crate::shapes::icosphere(1.0, 3);
+        let sphere = crate::eval::shapes::icosphere(1.0, 3);
         let mut s = Surface {
             normals: sphere.positions.clone(),
             labels: vec![0; sphere.positions.len()],

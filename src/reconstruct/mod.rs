@@ -913,7 +913,7 @@ mod tests {
         // Faces 0.1 wide over [0, 1]², samples on x <= 0.43 only: the border goes to 0.45
         // (0.02 past the samples) on the whole right side, where removing faces alone would
         // leave it at 0.4 or 0.5.
-        let mut mesh = crate::shapes::square_grid(10);
+        let mut mesh = crate::eval::shapes::square_grid(10);
         let samples: Vec<Vec3> =
             (0..=43).flat_map(|i| (0..=100).map(move |j| Vec3::new(i as f32 * 0.01, j as f32 * 0.01, 0.0))).collect();
         let near = KdTree::new(&samples).unwrap();

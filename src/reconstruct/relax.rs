@@ -164,7 +164,7 @@ mod tests {
     use super::*;
     use crate::mesh::Mesh;
     use crate::reconstruct::mls::tests::sphere_samples;
-    use crate::{rng::Rng, shapes, topology};
+    use crate::{eval::shapes, rng::Rng, topology};
 
     /// Share of triangles with an angle under `degrees`.
     fn thin_share(s: &Surface, degrees: f32) -> f32 {

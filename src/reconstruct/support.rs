@@ -178,7 +178,7 @@ pub(super) fn is_open(closure: Closure, unsupported_share: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shapes::icosphere;
+    use crate::eval::shapes::icosphere;
 
     #[test]
     fn a_sphere_sampled_on_one_half_is_half_unsupported() {

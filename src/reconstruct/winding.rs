@@ -180,8 +180,8 @@ mod tests {
 
     #[test]
     fn one_inside_a_torus_and_zero_outside_it() {
-        let torus = crate::shapes::torus(1.0, 0.35, 96, 48);
-        let cloud = crate::shapes::sample_surface(&torus, 30_000, 3);
+        let torus = crate::eval::shapes::torus(1.0, 0.35, 96, 48);
+        let cloud = crate::eval::shapes::sample_surface(&torus, 30_000, 3);
         let t = tree_of(&cloud);
         let w = WindingNumber::new(&t, 0.0);
         for p in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, -1.0, 0.0), Vec3::new(-0.8, 0.6, 0.0).normalize()] {
@@ -197,8 +197,8 @@ mod tests {
     fn softening_keeps_the_number_bounded_next_to_a_sample() {
         // On the samples the exact sum swings with the nearest one; softened over a spacing
         // it stays near one half, and deep inside and far outside it is unchanged.
-        let sphere = crate::shapes::icosphere(1.0, 5);
-        let cloud = crate::shapes::sample_surface(&sphere, 20_000, 5);
+        let sphere = crate::eval::shapes::icosphere(1.0, 5);
+        let cloud = crate::eval::shapes::sample_surface(&sphere, 20_000, 5);
         let t = tree_of(&cloud);
         let spacing = (4.0 * std::f32::consts::PI / 20_000.0).sqrt();
         let exact = WindingNumber::new(&t, 0.0);

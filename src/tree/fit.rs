@@ -146,8 +146,8 @@ fn prune(nodes: Vec<Node>, expanded: &[bool]) -> Vec<Node> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::eval::shapes;
     use crate::samples::{MeshSampling, SampleSet};
-    use crate::shapes;
     use crate::tree::{build, Metric, TreeKind, TreeParams};
     use crate::Progress;
 

@@ -359,9 +359,9 @@ impl VsTree {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::eval::shapes;
     use crate::progress::{Progress, Threads};
     use crate::samples::{MeshSampling, SampleSet};
-    use crate::shapes;
 
     fn tree_of(samples: &SampleSet, metric: Metric, error: f64) -> VsTree {
         let params = TreeParams { metric, error, ..Default::default() };

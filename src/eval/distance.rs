@@ -7,9 +7,9 @@
 //! point with a NaN coordinate gives NaN. Batch functions run in parallel and their output does
 //! not depend on the thread count (each result depends on its own query only).
 
+use crate::eval::shapes::sample_surface;
 use crate::mesh::{Mesh, MAX_COORDINATE};
 use crate::rng::stream_seed;
-use crate::shapes::sample_surface;
 use crate::spatial::{KdTree, TriangleBvh};
 use glam::Vec3;
 use rayon::prelude::*;

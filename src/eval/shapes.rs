@@ -417,7 +417,8 @@ pub fn add_noise(cloud: &mut Mesh, position_sigma: f32, normal_sigma_radians: f3
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::topology::{analyze, signed_volume};
+    use crate::eval::figures::signed_volume;
+    use crate::topology::analyze;
 
     #[test]
     fn implicit_sphere_is_watertight_and_outward() {
