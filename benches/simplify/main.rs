@@ -122,11 +122,8 @@ impl Options {
 
 fn main() {
     let args = common::cli::bench_args();
+    common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    if common::cli::wants_help(&args) {
-        println!("{USAGE}");
-        return;
-    }
     let options = common::cli::or_exit(Options::parse(&args, &root));
     match run(&options, &root, common::cli::command("simplify", &args)) {
         Ok(report) => {

@@ -129,11 +129,8 @@ impl Options {
 
 fn main() {
     let args = common::cli::bench_args();
+    common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    if common::cli::wants_help(&args) {
-        println!("{USAGE}");
-        return;
-    }
     if args.first().map(String::as_str) == Some("--memory-child") {
         memory_child(&args[1..], &root);
         return;
