@@ -21,6 +21,7 @@ mod report;
 
 use common::cli::{list, names, number, shown};
 use common::distance::Distances;
+use common::report::Clock;
 use common::stats::median;
 use report::{Context, Report, Row};
 use std::path::{Path, PathBuf};
@@ -243,8 +244,7 @@ fn vstree_run(
 }
 
 fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
-    let start = Instant::now();
-    let load_start = common::report::load_average();
+    let clock = Clock::start(command, o.threads);
     let mut rows = Vec::new();
     let mut curve = Vec::new();
     let mut notes = Vec::new();
@@ -319,19 +319,7 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     };
     rows.sort_by_key(key);
     curve.sort_by(|a, b| (a.input.as_str(), a.method.as_str()).cmp(&(b.input.as_str(), b.method.as_str())));
-    Ok(Report {
-        rows,
-        curve,
-        context: Context {
-            command,
-            runs: o.runs,
-            threads: o.threads,
-            load_start,
-            load_end: common::report::load_average(),
-            seconds: start.elapsed().as_secs_f64(),
-            notes,
-        },
-    })
+    Ok(Report { rows, curve, context: Context { run: clock.run(notes), runs: o.runs } })
 }
 
 /// One peer's run at one size, as `benches/peers.py` reports it.

@@ -21,11 +21,11 @@ mod report;
 
 use common::cli::{list, names, number, shown};
 use common::distance::Distances;
+use common::report::Clock;
 use inputs::Input;
 use measure::KINDS;
 use report::{Context, Method, Report, Row};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 use vstree::{Threads, TreeKind};
 
 const USAGE: &str = "\
@@ -143,8 +143,7 @@ fn memory_child(args: &[String], root: &Path) {
 
 /// Runs every measurement and gathers the report.
 fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
-    let start = Instant::now();
-    let load_start = common::report::load_average();
+    let clock = Clock::start(command, o.threads);
     let threads = Threads::new(o.threads)?;
     let mut rows = Vec::new();
     let mut methods = Vec::new();
@@ -226,17 +225,7 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
         sweep,
         methods,
         memory,
-        context: Context {
-            command,
-            runs: o.runs,
-            big_runs: o.big_runs,
-            threads: o.threads,
-            load_start,
-            load_end: common::report::load_average(),
-            seconds: start.elapsed().as_secs_f64(),
-            cloud_surface: surface_name,
-            notes,
-        },
+        context: Context { run: clock.run(notes), runs: o.runs, big_runs: o.big_runs, cloud_surface: surface_name },
     })
 }
 

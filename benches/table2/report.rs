@@ -1,7 +1,7 @@
 //! The Markdown report of Table 2: machine, targets, tables.
 
 use crate::common::inputs::short_count;
-use crate::common::report::{header, percent, relative, thousands, verdict};
+use crate::common::report::{percent, relative, thousands, verdict, Run};
 use crate::common::stats::{max, min};
 use crate::inputs::Normals;
 use crate::measure::{Quality, Stages, SMALL_ANGLE_DEGREES};
@@ -49,20 +49,15 @@ pub struct PeerRow {
     pub quality: Result<Quality, String>,
 }
 
-/// Where and how the run happened.
+/// Where and how the run happened: the common part and this bench's.
 pub struct Context {
-    pub command: String,
+    pub run: Run,
     pub runs: usize,
     pub big_runs: usize,
     pub peer_runs: usize,
     pub peers: bool,
-    pub threads: usize,
-    pub load_start: String,
-    pub load_end: String,
-    pub seconds: f64,
     /// The surface the dense clouds were drawn on, when any were.
     pub cloud_surface: Option<String>,
-    pub notes: Vec<String>,
 }
 
 /// Everything one run measured.
@@ -112,8 +107,8 @@ impl Report {
     /// The whole generated block, without the markers.
     pub fn markdown(&self) -> String {
         let c = &self.context;
-        let mut md = header(&c.command, &c.load_start, &c.load_end, c.seconds);
-        let threads = if c.threads == 0 { "all cores".to_string() } else { c.threads.to_string() };
+        let mut md = c.run.header();
+        let threads = c.run.threads_text("");
         let peers = match (c.peers, c.peer_runs) {
             (false, _) => " Peers not run (`--peers` not given).".to_string(),
             (true, runs) => format!(" Peers: {} each, on the same points with vstree's normals.", runs_phrase(runs)),
@@ -129,9 +124,7 @@ impl Report {
         if let Some(surface) = &c.cloud_surface {
             let _ = writeln!(md, "- Dense clouds are drawn on {surface}'s surface, with interpolated normals.");
         }
-        for note in &c.notes {
-            let _ = writeln!(md, "- {note}");
-        }
+        c.run.write_notes(&mut md);
         md.push('\n');
         self.targets(&mut md);
         self.table2(&mut md);
