@@ -153,11 +153,23 @@ pub fn ms(s: f64) -> String {
     }
 }
 
+/// Seconds with one decimal from 10 s, else two (the whole run's duration, table 1's big builds).
 pub fn seconds(s: f64) -> String {
     if s >= 10.0 {
         format!("{s:.1}")
     } else {
         format!("{s:.2}")
+    }
+}
+
+/// Seconds with about three significant digits (the reconstruction tables' times).
+pub fn secs(s: f64) -> String {
+    match s {
+        s if s >= 100.0 => format!("{s:.0}"),
+        s if s >= 10.0 => format!("{s:.1}"),
+        s if s >= 1.0 => format!("{s:.2}"),
+        s if s >= 0.1 => format!("{s:.3}"),
+        s => format!("{s:.4}"),
     }
 }
 
@@ -170,6 +182,11 @@ pub fn relative(x: f64) -> String {
     let p = 100.0 * x;
     let decimals = if p == 0.0 { 3 } else { (2 - p.abs().log10().floor() as i32).clamp(0, 5) as usize };
     format!("{p:.decimals$}%")
+}
+
+/// A relative distance as [`relative`] shows it, or a dash.
+pub fn relative_or_dash(x: Option<f64>) -> String {
+    x.map_or("—".into(), relative)
 }
 
 /// A (mean, max) pair of relative distances, or a dash.

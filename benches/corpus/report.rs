@@ -3,7 +3,7 @@
 
 use crate::common::inputs::short_count;
 use crate::common::reconstruction::Stages;
-use crate::common::report::{percent, relative, thousands, Run};
+use crate::common::report::{percent, relative, relative_or_dash, secs, thousands, Run};
 use crate::common::stats::median;
 use crate::inputs::{Variant, TRUTH_SAMPLES};
 use crate::measure::{Quality, FOLD_DEGREES};
@@ -126,21 +126,6 @@ impl Row {
             }
         }
     }
-}
-
-/// Seconds with about three significant digits.
-fn secs(s: f64) -> String {
-    match s {
-        s if s >= 100.0 => format!("{s:.0}"),
-        s if s >= 10.0 => format!("{s:.1}"),
-        s if s >= 1.0 => format!("{s:.2}"),
-        s if s >= 0.1 => format!("{s:.3}"),
-        s => format!("{s:.4}"),
-    }
-}
-
-fn rel(x: Option<f64>) -> String {
-    x.map_or("—".into(), relative)
 }
 
 fn ratio(x: f64) -> String {
@@ -446,8 +431,8 @@ fn quality_row(md: &mut String, r: &Row, method: &str, seconds: f64, q: &Quality
         thousands(q.vertices),
         thousands(q.components),
         thousands(r.truth_components),
-        rel(q.distances.chamfer()),
-        rel(q.distances.hausdorff()),
+        relative_or_dash(q.distances.chamfer()),
+        relative_or_dash(q.distances.hausdorff()),
         percent(q.under10),
         percent(q.under20),
         percent(q.valence6),

@@ -1,7 +1,7 @@
 //! The Markdown report of Table 2: machine, targets, tables.
 
 use crate::common::inputs::short_count;
-use crate::common::report::{percent, relative, thousands, verdict, Run};
+use crate::common::report::{percent, relative, relative_or_dash, secs, thousands, verdict, Run};
 use crate::common::stats::{max, min};
 use crate::inputs::Normals;
 use crate::measure::{Quality, Stages, SMALL_ANGLE_DEGREES};
@@ -67,17 +67,6 @@ pub struct Report {
     pub context: Context,
 }
 
-/// Seconds with about three significant digits.
-fn secs(s: f64) -> String {
-    match s {
-        s if s >= 100.0 => format!("{s:.0}"),
-        s if s >= 10.0 => format!("{s:.1}"),
-        s if s >= 1.0 => format!("{s:.2}"),
-        s if s >= 0.1 => format!("{s:.3}"),
-        s => format!("{s:.4}"),
-    }
-}
-
 /// `1 run`, `3 runs`.
 fn runs_phrase(n: usize) -> String {
     if n == 1 {
@@ -85,11 +74,6 @@ fn runs_phrase(n: usize) -> String {
     } else {
         format!("{n} runs")
     }
-}
-
-/// A relative distance, or a dash.
-fn rel(x: Option<f64>) -> String {
-    x.map_or("—".into(), relative)
 }
 
 /// The method's name as the tables show it.
@@ -227,8 +211,8 @@ impl Report {
                 r.input,
                 secs(r.seconds.total),
                 secs(*poisson_seconds),
-                rel(r.quality.distances.chamfer()),
-                rel(poisson.distances.chamfer()),
+                relative_or_dash(r.quality.distances.chamfer()),
+                relative_or_dash(poisson.distances.chamfer()),
                 if ok { "" } else { " ✗" }
             ));
         }
@@ -389,8 +373,8 @@ fn quality_row(md: &mut String, input: &str, points: usize, method: &str, second
         secs(seconds),
         thousands(q.vertices),
         thousands(q.triangles),
-        rel(q.distances.chamfer()),
-        rel(q.distances.hausdorff()),
+        relative_or_dash(q.distances.chamfer()),
+        relative_or_dash(q.distances.hausdorff()),
         percent(q.valence6),
         percent(q.small_angles),
         q.genus.map_or("—".into(), |g| g.to_string()),
