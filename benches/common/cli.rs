@@ -23,6 +23,14 @@ pub fn or_exit<T>(parsed: Result<T, String>) -> T {
     })
 }
 
+/// The bench's `result`, or else `<bench>: <error>` on stderr and exit code 1.
+pub fn or_fail<T, E: std::fmt::Display>(bench: &str, result: Result<T, E>) -> T {
+    result.unwrap_or_else(|e| {
+        eprintln!("{bench}: {e}");
+        std::process::exit(1)
+    })
+}
+
 /// The command line as the report shows it: `cargo bench --bench <name> -- <args>`.
 pub fn command(bench: &str, args: &[String]) -> String {
     if args.is_empty() {

@@ -218,13 +218,8 @@ fn main() {
     common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let options = common::cli::or_exit(Options::parse(&args, &root));
-    match run(&options, &root, common::cli::command("corpus", &args)) {
-        Ok(report) => common::report::publish(&root, "corpus", &report.markdown(), options.write),
-        Err(e) => {
-            eprintln!("corpus: {e}");
-            std::process::exit(1);
-        }
-    }
+    let report = common::cli::or_fail("corpus", run(&options, &root, common::cli::command("corpus", &args)));
+    common::report::publish(&root, "corpus", &report.markdown(), options.write);
 }
 
 /// One input to reconstruct and what it is measured against.

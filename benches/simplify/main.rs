@@ -126,17 +126,10 @@ fn main() {
     common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let options = common::cli::or_exit(Options::parse(&args, &root));
-    match run(&options, &root, common::cli::command("simplify", &args)) {
-        Ok(report) => {
-            common::report::publish(&root, "simplify", &report.markdown(), options.write);
-            if options.write && !report.curve.is_empty() {
-                plot(&root, &report);
-            }
-        }
-        Err(e) => {
-            eprintln!("simplify: {e}");
-            std::process::exit(1);
-        }
+    let report = common::cli::or_fail("simplify", run(&options, &root, common::cli::command("simplify", &args)));
+    common::report::publish(&root, "simplify", &report.markdown(), options.write);
+    if options.write && !report.curve.is_empty() {
+        plot(&root, &report);
     }
 }
 

@@ -120,13 +120,8 @@ fn main() {
         return;
     }
     let options = common::cli::or_exit(Options::parse(&args, &root));
-    match run(&options, &root, common::cli::command("table1", &args)) {
-        Ok(report) => common::report::publish(&root, "table1", &report.markdown(), options.write),
-        Err(e) => {
-            eprintln!("table1: {e}");
-            std::process::exit(1);
-        }
-    }
+    let report = common::cli::or_fail("table1", run(&options, &root, common::cli::command("table1", &args)));
+    common::report::publish(&root, "table1", &report.markdown(), options.write);
 }
 
 /// `--memory-child <octree|vstree> <bound> <count> [--data DIR] [--threads N]`.

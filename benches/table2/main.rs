@@ -136,13 +136,8 @@ fn main() {
         return;
     }
     let options = common::cli::or_exit(Options::parse(&args, &root));
-    match run(&options, &root, common::cli::command("table2", &args)) {
-        Ok(report) => common::report::publish(&root, "table2", &report.markdown(), options.write),
-        Err(e) => {
-            eprintln!("table2: {e}");
-            std::process::exit(1);
-        }
-    }
+    let report = common::cli::or_fail("table2", run(&options, &root, common::cli::command("table2", &args)));
+    common::report::publish(&root, "table2", &report.markdown(), options.write);
 }
 
 /// `--memory-child <count> [--data DIR] [--threads N]`.
