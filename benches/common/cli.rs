@@ -7,9 +7,12 @@ pub fn bench_args() -> Vec<String> {
     std::env::args().skip(1).filter(|a| a != "--bench").collect()
 }
 
-/// Whether `args` asks for help.
-pub fn wants_help(args: &[String]) -> bool {
-    args.iter().any(|a| a == "--help" || a == "-h")
+/// When `args` asks for help (`--help` or `-h`), prints `usage` and exits with code 0.
+pub fn exit_on_help(args: &[String], usage: &str) {
+    if args.iter().any(|a| a == "--help" || a == "-h") {
+        println!("{usage}");
+        std::process::exit(0)
+    }
 }
 
 /// The options `parsed` from the command line, or else its message on stderr and exit code 2.
@@ -17,6 +20,14 @@ pub fn or_exit<T>(parsed: Result<T, String>) -> T {
     parsed.unwrap_or_else(|message| {
         eprintln!("{message}");
         std::process::exit(2)
+    })
+}
+
+/// The bench's `result`, or else `<bench>: <error>` on stderr and exit code 1.
+pub fn or_fail<T, E: std::fmt::Display>(bench: &str, result: Result<T, E>) -> T {
+    result.unwrap_or_else(|e| {
+        eprintln!("{bench}: {e}");
+        std::process::exit(1)
     })
 }
 

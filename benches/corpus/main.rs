@@ -23,12 +23,12 @@ mod report;
 use common::cli::{list, names, number, shown};
 use common::inputs::short_count;
 use common::reconstruction::{reconstruction, run_peers, Outcome};
+use common::report::Clock;
 use glam::DVec3;
 use inputs::{Truth, Variant};
 use measure::{quality, Samples};
 use report::{Context, PeerRow, Report, Row};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 use vstree::normals::{ensure_normals, NormalParams};
 use vstree::reconstruct::{BaseMesh, ReconstructParams};
 use vstree::{io, Mesh, Progress};
@@ -215,19 +215,11 @@ impl Options {
 
 fn main() {
     let args = common::cli::bench_args();
+    common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    if common::cli::wants_help(&args) {
-        println!("{USAGE}");
-        return;
-    }
     let options = common::cli::or_exit(Options::parse(&args, &root));
-    match run(&options, &root, common::cli::command("corpus", &args)) {
-        Ok(report) => common::report::publish(&root, "corpus", &report.markdown(), options.write),
-        Err(e) => {
-            eprintln!("corpus: {e}");
-            std::process::exit(1);
-        }
-    }
+    let report = common::cli::or_fail("corpus", run(&options, &root, common::cli::command("corpus", &args)));
+    common::report::publish(&root, "corpus", &report.markdown(), options.write);
 }
 
 /// One input to reconstruct and what it is measured against.
@@ -258,18 +250,16 @@ struct Bench<'a> {
     o: &'a Options,
     root: &'a Path,
     out_dir: PathBuf,
-    command: String,
-    load_start: String,
+    clock: Clock,
     rows: Vec<Row>,
     notes: Vec<String>,
     done: usize,
     total: usize,
-    start: Instant,
 }
 
 /// Runs every measurement and gathers the report.
 fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
-    let load_start = common::report::load_average();
+    let clock = Clock::start(command, o.threads);
     let out_dir = root.join("target").join("bench-corpus");
     std::fs::create_dir_all(&out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
     let models: Vec<inputs::Model> = inputs::models(&o.data).into_iter().filter(|m| o.wants(&m.name)).collect();
@@ -277,18 +267,7 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
         if o.synthetic { inputs::SINGLE_VIEWS.iter().copied().filter(|m| o.wants(m)).collect() } else { Vec::new() };
     let synthetic = if o.synthetic { o.hemispheres().len() + 1 + inputs::OFFSETS.len() } else { 0 };
     let total = models.iter().map(|m| o.samplings(m.corpus).len()).sum::<usize>() + views.len() + synthetic;
-    let mut bench = Bench {
-        o,
-        root,
-        out_dir,
-        command,
-        load_start,
-        rows: Vec::new(),
-        notes: Vec::new(),
-        done: 0,
-        total,
-        start: Instant::now(),
-    };
+    let mut bench = Bench { o, root, out_dir, clock, rows: Vec::new(), notes: Vec::new(), done: 0, total };
     if o.base_mesh == BaseMesh::Paper {
         bench.notes.push("vstree's base mesh: the paper's blended T-node planes (`--base-mesh paper`).".into());
     }
@@ -370,17 +349,11 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
 impl Bench<'_> {
     /// The report's context now; `partial` adds a note that the run is not finished.
     fn context(&self, partial: Option<String>) -> Context {
-        let o = self.o;
         Context {
-            command: self.command.clone(),
-            peers: o.peers,
-            runs: o.runs,
-            peer_runs: o.peer_runs,
-            threads: o.threads,
-            load_start: self.load_start.clone(),
-            load_end: common::report::load_average(),
-            seconds: self.start.elapsed().as_secs_f64(),
-            notes: self.notes.iter().cloned().chain(partial).collect(),
+            run: self.clock.run(self.notes.iter().cloned().chain(partial).collect()),
+            peers: self.o.peers,
+            runs: self.o.runs,
+            peer_runs: self.o.peer_runs,
         }
     }
 
@@ -400,12 +373,7 @@ impl Bench<'_> {
         self.done += 1;
         let points = case.cloud.positions.len();
         let label = format!("{} {} {}", case.name, short_count(points), case.variant.name());
-        eprintln!(
-            "corpus: [{}/{}, {:.0} s] {label}: vstree",
-            self.done,
-            self.total,
-            self.start.elapsed().as_secs_f64()
-        );
+        eprintln!("corpus: [{}/{}, {:.0} s] {label}: vstree", self.done, self.total, self.clock.elapsed());
         let open = case.truth.open;
         // Defaults on every input: open or closed is found, not told.
         let params =

@@ -3,7 +3,7 @@
 
 use crate::common::inputs::short_count;
 use crate::common::reconstruction::Stages;
-use crate::common::report::{header, percent, relative, thousands};
+use crate::common::report::{percent, relative, relative_or_dash, secs, thousands, Run};
 use crate::common::stats::median;
 use crate::inputs::{Variant, TRUTH_SAMPLES};
 use crate::measure::{Quality, FOLD_DEGREES};
@@ -37,17 +37,12 @@ pub struct PeerRow {
     pub quality: Result<Quality, String>,
 }
 
-/// Where and how the run happened.
+/// Where and how the run happened: the common part and this bench's.
 pub struct Context {
-    pub command: String,
+    pub run: Run,
     pub peers: bool,
     pub runs: usize,
     pub peer_runs: usize,
-    pub threads: usize,
-    pub load_start: String,
-    pub load_end: String,
-    pub seconds: f64,
-    pub notes: Vec<String>,
 }
 
 /// Everything one run measured.
@@ -133,21 +128,6 @@ impl Row {
     }
 }
 
-/// Seconds with about three significant digits.
-fn secs(s: f64) -> String {
-    match s {
-        s if s >= 100.0 => format!("{s:.0}"),
-        s if s >= 10.0 => format!("{s:.1}"),
-        s if s >= 1.0 => format!("{s:.2}"),
-        s if s >= 0.1 => format!("{s:.3}"),
-        s => format!("{s:.4}"),
-    }
-}
-
-fn rel(x: Option<f64>) -> String {
-    x.map_or("—".into(), relative)
-}
-
 fn ratio(x: f64) -> String {
     if x.is_finite() {
         format!("{x:.2}")
@@ -171,8 +151,8 @@ impl Report {
     /// The whole generated block, without the markers.
     pub fn markdown(&self) -> String {
         let c = &self.context;
-        let mut md = header(&c.command, &c.load_start, &c.load_end, c.seconds);
-        let threads = if c.threads == 0 { "all cores".to_string() } else { c.threads.to_string() };
+        let mut md = c.run.header();
+        let threads = c.run.threads_text("");
         let peers = if c.peers {
             format!(
                 " Peers: {} run{} each, all cores, on the same points with the normals vstree uses.",
@@ -189,9 +169,7 @@ impl Report {
             c.runs,
             if c.runs == 1 { "" } else { "s" }
         );
-        for note in &c.notes {
-            let _ = writeln!(md, "- {note}");
-        }
+        c.run.write_notes(&mut md);
         md.push('\n');
         self.summary(&mut md);
         self.rows_table(&mut md);
@@ -453,8 +431,8 @@ fn quality_row(md: &mut String, r: &Row, method: &str, seconds: f64, q: &Quality
         thousands(q.vertices),
         thousands(q.components),
         thousands(r.truth_components),
-        rel(q.distances.chamfer()),
-        rel(q.distances.hausdorff()),
+        relative_or_dash(q.distances.chamfer()),
+        relative_or_dash(q.distances.hausdorff()),
         percent(q.under10),
         percent(q.under20),
         percent(q.valence6),

@@ -21,6 +21,7 @@ mod report;
 
 use common::cli::{list, names, number, shown};
 use common::distance::Distances;
+use common::report::Clock;
 use common::stats::median;
 use report::{Context, Report, Row};
 use std::path::{Path, PathBuf};
@@ -122,23 +123,13 @@ impl Options {
 
 fn main() {
     let args = common::cli::bench_args();
+    common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    if common::cli::wants_help(&args) {
-        println!("{USAGE}");
-        return;
-    }
     let options = common::cli::or_exit(Options::parse(&args, &root));
-    match run(&options, &root, common::cli::command("simplify", &args)) {
-        Ok(report) => {
-            common::report::publish(&root, "simplify", &report.markdown(), options.write);
-            if options.write && !report.curve.is_empty() {
-                plot(&root, &report);
-            }
-        }
-        Err(e) => {
-            eprintln!("simplify: {e}");
-            std::process::exit(1);
-        }
+    let report = common::cli::or_fail("simplify", run(&options, &root, common::cli::command("simplify", &args)));
+    common::report::publish(&root, "simplify", &report.markdown(), options.write);
+    if options.write && !report.curve.is_empty() {
+        plot(&root, &report);
     }
 }
 
@@ -246,8 +237,7 @@ fn vstree_run(
 }
 
 fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
-    let start = Instant::now();
-    let load_start = common::report::load_average();
+    let clock = Clock::start(command, o.threads);
     let mut rows = Vec::new();
     let mut curve = Vec::new();
     let mut notes = Vec::new();
@@ -322,19 +312,7 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     };
     rows.sort_by_key(key);
     curve.sort_by(|a, b| (a.input.as_str(), a.method.as_str()).cmp(&(b.input.as_str(), b.method.as_str())));
-    Ok(Report {
-        rows,
-        curve,
-        context: Context {
-            command,
-            runs: o.runs,
-            threads: o.threads,
-            load_start,
-            load_end: common::report::load_average(),
-            seconds: start.elapsed().as_secs_f64(),
-            notes,
-        },
-    })
+    Ok(Report { rows, curve, context: Context { run: clock.run(notes), runs: o.runs } })
 }
 
 /// One peer's run at one size, as `benches/peers.py` reports it.

@@ -2,7 +2,7 @@
 //! numbers, a summary per method and size, and the full table per size.
 
 use crate::common::distance::Distances;
-use crate::common::report::{header, ms, percent, relative, thousands, verdict};
+use crate::common::report::{ms, percent, relative, thousands, verdict, Run};
 use crate::common::stats::{max, median, min};
 use crate::{NEW_MODE, REFERENCE};
 use std::fmt::Write as _;
@@ -29,14 +29,10 @@ pub struct Row {
     pub genus_kept: Option<bool>,
 }
 
+/// Where and how the run happened: the common part and this bench's.
 pub struct Context {
-    pub command: String,
+    pub run: Run,
     pub runs: usize,
-    pub threads: usize,
-    pub load_start: String,
-    pub load_end: String,
-    pub seconds: f64,
-    pub notes: Vec<String>,
 }
 
 pub struct Report {
@@ -107,7 +103,7 @@ impl Report {
 
     pub fn markdown(&self) -> String {
         let c = &self.context;
-        let mut md = header(&c.command, &c.load_start, &c.load_end, c.seconds);
+        let mut md = c.run.header();
         let _ = writeln!(
             md,
             "- Times: median of {} runs of the call alone, the mesh already in memory, in process; vstree on {} \
@@ -115,11 +111,9 @@ impl Report {
              input's bounding-box diagonal; Chamfer = mean of the two one-sided mean distances (200k points on the \
              output, the input's vertices), Hausdorff = the larger one-sided maximum.",
             c.runs,
-            if c.threads == 0 { "all cores".to_string() } else { format!("{} threads", c.threads) },
+            c.run.threads_text(" threads"),
         );
-        for note in &c.notes {
-            let _ = writeln!(md, "- {note}");
-        }
+        c.run.write_notes(&mut md);
         md.push('\n');
         self.targets(&mut md);
         self.summary(&mut md);

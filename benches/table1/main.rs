@@ -21,11 +21,11 @@ mod report;
 
 use common::cli::{list, names, number, shown};
 use common::distance::Distances;
+use common::report::Clock;
 use inputs::Input;
 use measure::KINDS;
 use report::{Context, Method, Report, Row};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 use vstree::{Threads, TreeKind};
 
 const USAGE: &str = "\
@@ -113,23 +113,15 @@ impl Options {
 
 fn main() {
     let args = common::cli::bench_args();
+    common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    if common::cli::wants_help(&args) {
-        println!("{USAGE}");
-        return;
-    }
     if args.first().map(String::as_str) == Some("--memory-child") {
         memory_child(&args[1..], &root);
         return;
     }
     let options = common::cli::or_exit(Options::parse(&args, &root));
-    match run(&options, &root, common::cli::command("table1", &args)) {
-        Ok(report) => common::report::publish(&root, "table1", &report.markdown(), options.write),
-        Err(e) => {
-            eprintln!("table1: {e}");
-            std::process::exit(1);
-        }
-    }
+    let report = common::cli::or_fail("table1", run(&options, &root, common::cli::command("table1", &args)));
+    common::report::publish(&root, "table1", &report.markdown(), options.write);
 }
 
 /// `--memory-child <octree|vstree> <bound> <count> [--data DIR] [--threads N]`.
@@ -146,8 +138,7 @@ fn memory_child(args: &[String], root: &Path) {
 
 /// Runs every measurement and gathers the report.
 fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
-    let start = Instant::now();
-    let load_start = common::report::load_average();
+    let clock = Clock::start(command, o.threads);
     let threads = Threads::new(o.threads)?;
     let mut rows = Vec::new();
     let mut methods = Vec::new();
@@ -229,17 +220,7 @@ fn run(o: &Options, root: &Path, command: String) -> vstree::Result<Report> {
         sweep,
         methods,
         memory,
-        context: Context {
-            command,
-            runs: o.runs,
-            big_runs: o.big_runs,
-            threads: o.threads,
-            load_start,
-            load_end: common::report::load_average(),
-            seconds: start.elapsed().as_secs_f64(),
-            cloud_surface: surface_name,
-            notes,
-        },
+        context: Context { run: clock.run(notes), runs: o.runs, big_runs: o.big_runs, cloud_surface: surface_name },
     })
 }
 

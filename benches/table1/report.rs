@@ -2,7 +2,7 @@
 
 use crate::common::distance::Distances;
 use crate::common::inputs::short_count;
-use crate::common::report::{bound, header, mean_max, ms, percent, seconds, thousands, verdict};
+use crate::common::report::{bound, mean_max, ms, percent, seconds, thousands, verdict, Run};
 use crate::common::stats::{geometric_mean, max, median, min};
 use crate::measure::{reduction, Build, SweepRow};
 use crate::memory::Memory;
@@ -61,17 +61,12 @@ pub struct Method {
     pub distances: Distances,
 }
 
-/// Where and how the run happened.
+/// Where and how the run happened: the common part and this bench's.
 pub struct Context {
-    pub command: String,
+    pub run: Run,
     pub runs: usize,
     pub big_runs: usize,
-    pub threads: usize,
-    pub load_start: String,
-    pub load_end: String,
-    pub seconds: f64,
     pub cloud_surface: String,
-    pub notes: Vec<String>,
 }
 
 /// Everything one run measured.
@@ -97,17 +92,15 @@ impl Report {
     /// The whole generated block, without the markers.
     pub fn markdown(&self) -> String {
         let c = &self.context;
-        let mut md = header(&c.command, &c.load_start, &c.load_end, c.seconds);
-        let threads = if c.threads == 0 { "all cores".to_string() } else { c.threads.to_string() };
+        let mut md = c.run.header();
+        let threads = c.run.threads_text("");
         let _ = writeln!(
             md,
             "- Times are medians of {} runs ({} for inputs of 1M samples or more), octree and \
              VS-Tree builds interleaved; threads: {threads}. Dense clouds are drawn on {}.",
             c.runs, c.big_runs, c.cloud_surface
         );
-        for note in &c.notes {
-            let _ = writeln!(md, "- {note}");
-        }
+        c.run.write_notes(&mut md);
         md.push('\n');
         self.targets(&mut md);
         self.table1(&mut md);

@@ -21,11 +21,11 @@ mod peers;
 mod report;
 
 use common::cli::{list, names, number, shown};
+use common::report::Clock;
 use inputs::{Input, Normals};
 use peers::Outcome;
 use report::{Context, PeerRow, Report, Row};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 use vstree::normals::{ensure_normals, NormalParams};
 use vstree::reconstruct::ReconstructParams;
 use vstree::{io, Progress};
@@ -129,23 +129,15 @@ impl Options {
 
 fn main() {
     let args = common::cli::bench_args();
+    common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    if common::cli::wants_help(&args) {
-        println!("{USAGE}");
-        return;
-    }
     if args.first().map(String::as_str) == Some("--memory-child") {
         memory_child(&args[1..], &root);
         return;
     }
     let options = common::cli::or_exit(Options::parse(&args, &root));
-    match run(&options, &root, common::cli::command("table2", &args)) {
-        Ok(report) => common::report::publish(&root, "table2", &report.markdown(), options.write),
-        Err(e) => {
-            eprintln!("table2: {e}");
-            std::process::exit(1);
-        }
-    }
+    let report = common::cli::or_fail("table2", run(&options, &root, common::cli::command("table2", &args)));
+    common::report::publish(&root, "table2", &report.markdown(), options.write);
 }
 
 /// `--memory-child <count> [--data DIR] [--threads N]`.
@@ -168,8 +160,7 @@ pub fn params(input: &Input, threads: usize) -> ReconstructParams {
 
 /// Runs every measurement and gathers the report.
 fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
-    let start = Instant::now();
-    let load_start = common::report::load_average();
+    let clock = Clock::start(command, o.threads);
     let out_dir = root.join("target").join("bench-table2");
     std::fs::create_dir_all(&out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
     let setup = peers::Setup {
@@ -224,17 +215,12 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
         rows,
         memory,
         context: Context {
-            command,
+            run: clock.run(notes),
             runs: o.runs,
             big_runs: o.big_runs,
             peer_runs: o.peer_runs,
             peers: o.peers,
-            threads: o.threads,
-            load_start,
-            load_end: common::report::load_average(),
-            seconds: start.elapsed().as_secs_f64(),
             cloud_surface: surface,
-            notes,
         },
     })
 }

@@ -1,7 +1,7 @@
 //! The Markdown report of Table 2: machine, targets, tables.
 
 use crate::common::inputs::short_count;
-use crate::common::report::{header, percent, relative, thousands, verdict};
+use crate::common::report::{percent, relative, relative_or_dash, secs, thousands, verdict, Run};
 use crate::common::stats::{max, min};
 use crate::inputs::Normals;
 use crate::measure::{Quality, Stages, SMALL_ANGLE_DEGREES};
@@ -49,20 +49,15 @@ pub struct PeerRow {
     pub quality: Result<Quality, String>,
 }
 
-/// Where and how the run happened.
+/// Where and how the run happened: the common part and this bench's.
 pub struct Context {
-    pub command: String,
+    pub run: Run,
     pub runs: usize,
     pub big_runs: usize,
     pub peer_runs: usize,
     pub peers: bool,
-    pub threads: usize,
-    pub load_start: String,
-    pub load_end: String,
-    pub seconds: f64,
     /// The surface the dense clouds were drawn on, when any were.
     pub cloud_surface: Option<String>,
-    pub notes: Vec<String>,
 }
 
 /// Everything one run measured.
@@ -72,17 +67,6 @@ pub struct Report {
     pub context: Context,
 }
 
-/// Seconds with about three significant digits.
-fn secs(s: f64) -> String {
-    match s {
-        s if s >= 100.0 => format!("{s:.0}"),
-        s if s >= 10.0 => format!("{s:.1}"),
-        s if s >= 1.0 => format!("{s:.2}"),
-        s if s >= 0.1 => format!("{s:.3}"),
-        s => format!("{s:.4}"),
-    }
-}
-
 /// `1 run`, `3 runs`.
 fn runs_phrase(n: usize) -> String {
     if n == 1 {
@@ -90,11 +74,6 @@ fn runs_phrase(n: usize) -> String {
     } else {
         format!("{n} runs")
     }
-}
-
-/// A relative distance, or a dash.
-fn rel(x: Option<f64>) -> String {
-    x.map_or("—".into(), relative)
 }
 
 /// The method's name as the tables show it.
@@ -112,8 +91,8 @@ impl Report {
     /// The whole generated block, without the markers.
     pub fn markdown(&self) -> String {
         let c = &self.context;
-        let mut md = header(&c.command, &c.load_start, &c.load_end, c.seconds);
-        let threads = if c.threads == 0 { "all cores".to_string() } else { c.threads.to_string() };
+        let mut md = c.run.header();
+        let threads = c.run.threads_text("");
         let peers = match (c.peers, c.peer_runs) {
             (false, _) => " Peers not run (`--peers` not given).".to_string(),
             (true, runs) => format!(" Peers: {} each, on the same points with vstree's normals.", runs_phrase(runs)),
@@ -129,9 +108,7 @@ impl Report {
         if let Some(surface) = &c.cloud_surface {
             let _ = writeln!(md, "- Dense clouds are drawn on {surface}'s surface, with interpolated normals.");
         }
-        for note in &c.notes {
-            let _ = writeln!(md, "- {note}");
-        }
+        c.run.write_notes(&mut md);
         md.push('\n');
         self.targets(&mut md);
         self.table2(&mut md);
@@ -234,8 +211,8 @@ impl Report {
                 r.input,
                 secs(r.seconds.total),
                 secs(*poisson_seconds),
-                rel(r.quality.distances.chamfer()),
-                rel(poisson.distances.chamfer()),
+                relative_or_dash(r.quality.distances.chamfer()),
+                relative_or_dash(poisson.distances.chamfer()),
                 if ok { "" } else { " ✗" }
             ));
         }
@@ -396,8 +373,8 @@ fn quality_row(md: &mut String, input: &str, points: usize, method: &str, second
         secs(seconds),
         thousands(q.vertices),
         thousands(q.triangles),
-        rel(q.distances.chamfer()),
-        rel(q.distances.hausdorff()),
+        relative_or_dash(q.distances.chamfer()),
+        relative_or_dash(q.distances.hausdorff()),
         percent(q.valence6),
         percent(q.small_angles),
         q.genus.map_or("—".into(), |g| g.to_string()),
