@@ -28,26 +28,28 @@ mod base_mesh;
 mod implicit;
 mod leaf_fit;
 mod mls;
+mod params;
 mod refine;
 mod relax;
 mod support;
+mod trim;
 mod winding;
 
+pub use params::{BaseMesh, ReconstructParams, ReconstructStats, RefinementStop};
 pub use refine::LevelStats;
 pub use support::Closure;
 
 use crate::error::{shown, Error, Result};
 use crate::mesh::Mesh;
-use crate::normals::{self, NormalParams, NormalsReport, OrientReport};
+use crate::normals::{self, NormalParams, OrientReport};
 use crate::polygonise::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
 use crate::progress::{Progress, Threads};
 use crate::samples::SampleSet;
 use crate::spatial::{KdTree, TriangleBvh};
 use crate::topology;
-use crate::tree::{self, NodeKind, TreeKind, TreeParams, TreeSample, TreeStats, VsTree};
+use crate::tree::{self, NodeKind, TreeParams, TreeSample, VsTree};
 use glam::Vec3;
 use rayon::prelude::*;
-use std::ffi::CStr;
 use std::time::Instant;
 
 /// At most this many samples are measured for error(M, S).
@@ -85,11 +87,9 @@ const OPEN_SCAN_INSIDE: f32 = 0.25;
 /// grid resolves faithfully anyway. Surfaces without handles are never thickened.
 const THICKEN_CELLS: f32 = 1.5;
 /// An open output's border is cut back to this many sample spacings from the samples (see
-/// `trim_border`): the samples cannot place a border more finely than their spacing, and
+/// `trim::border`): the samples cannot place a border more finely than their spacing, and
 /// within one spacing of the last samples the cut would wander with each gap between them.
 const BORDER_TRIM: f32 = 2.0;
-/// Bisection steps when a border corner slides back (see `trim_border`): to 1/256 of its edge.
-const BORDER_SLIDE_STEPS: usize = 8;
 /// On an open M0, one vertex stands for a stretch of border at most this many typical T-node
 /// sides long (inside, one vertex stands for a T-node): a vertex per T-node along the border
 /// too cuts its bends short by as much as the T-node is large, and a flat region's T-node can
@@ -123,200 +123,6 @@ const NORMAL_SMOOTHING_PASSES: usize = 2;
 const MAX_GRID_CELLS: usize = 50_000_000;
 /// Fewer points than this cannot define a surface.
 pub const MIN_POINTS: usize = 10;
-
-/// What decides inside and outside for the base mesh.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum BaseMesh {
-    /// The samples' winding number gives the side everywhere, the distance to the nearest
-    /// sample the value. The winding number is a property of the whole cloud, so the topology
-    /// does not depend on how large the T-nodes near a thin part or a narrow gap are, and the
-    /// distance keeps details down to the sample spacing. The default.
-    #[default]
-    Winding,
-    /// The paper's §5.2: the T-nodes' planes blended by a partition of unity near the samples
-    /// (the winding number only decides beyond them). Kept to compare with.
-    Paper,
-}
-
-/// Parameters of [`reconstruct`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ReconstructParams {
-    /// The tree: its L2 bound smooths noise (larger = smoother, fewer details); `d_a`/`d_d`
-    /// set how deep the T-layer goes, i.e. how dense M0 is where curvature is high.
-    pub tree: TreeParams,
-    /// Stop refining once error(M, S) (RMS distance over the diagonal) is at most this.
-    /// 0 = refine until the quadtrees have no detail left or `max_levels`.
-    pub target_distance: f64,
-    /// Most refinement levels (each multiplies the triangle count by 4). 0-12.
-    pub max_levels: u32,
-    /// A level that displaces fewer than this fraction of its new vertices ends refinement:
-    /// the quadtrees have no detail left for further levels. In [0, 1].
-    pub min_displaced: f64,
-    /// No level is started that would exceed this many triangles.
-    pub max_triangles: usize,
-    /// The polygonisation grid is as fine as the deepest T-node, but never finer than
-    /// 2^`max_grid_depth` cells across. 4-20.
-    pub max_grid_depth: u32,
-    /// Remove faces farther than this many grid cells from every sample (open scans give
-    /// open meshes); 0 keeps the closed surface. Above 0 the input is taken to be open, and
-    /// the closing sheet behind it is placed farther back, so that it is trimmed away.
-    pub trim: f32,
-    /// Open or closed output: by default (`Auto`) open where much of the closed surface is far
-    /// from every sample (a scan from one side), closed otherwise (holes closed over); `Open`
-    /// keeps only the part of the surface the samples support (a scan's holes too), `Closed`
-    /// always closes.
-    pub closure: Closure,
-    /// How the base mesh's inside and outside are decided.
-    pub base_mesh: BaseMesh,
-    /// Normals: estimated where the cloud has none (PCA over neighbours, oriented by spanning
-    /// tree propagation, turned outward); the cloud's own are kept unless
-    /// `normals.reorient_given`.
-    pub normals: NormalParams,
-    /// Worker threads; 0 = all cores.
-    pub threads: usize,
-}
-
-impl Default for ReconstructParams {
-    fn default() -> Self {
-        ReconstructParams {
-            tree: TreeParams { error: 1e-5, ..TreeParams::default() },
-            target_distance: 0.0,
-            max_levels: 6,
-            min_displaced: 0.02,
-            max_triangles: 20_000_000,
-            max_grid_depth: 10,
-            trim: 0.0,
-            closure: Closure::Auto,
-            base_mesh: BaseMesh::Winding,
-            normals: NormalParams::default(),
-            threads: 0,
-        }
-    }
-}
-
-impl ReconstructParams {
-    /// Rejects values outside their documented ranges, naming the parameter.
-    pub fn check(&self) -> Result<()> {
-        self.tree.check()?;
-        // Even when the cloud's own normals are kept: a value outside the range is a mistake.
-        self.normals.check()?;
-        if self.tree.kind != TreeKind::VsTree {
-            return Err(Error::param(
-                "tree_kind",
-                "octree: reconstruction needs the VS-Tree, whose T-nodes make the base mesh (the octree is \
-                 for simplification)",
-            ));
-        }
-        if !(self.target_distance.is_finite() && self.target_distance >= 0.0) {
-            return Err(Error::param(
-                "target_distance",
-                format!("{}: must be a finite number >= 0", self.target_distance),
-            ));
-        }
-        if self.max_levels > 12 {
-            return Err(Error::param("max_levels", format!("{}: must be from 0 to 12", self.max_levels)));
-        }
-        if !(0.0..=1.0).contains(&self.min_displaced) {
-            return Err(Error::param("min_displaced", format!("{}: must be in [0, 1]", self.min_displaced)));
-        }
-        if self.max_triangles == 0 || self.max_triangles > u32::MAX as usize {
-            return Err(Error::param(
-                "max_triangles",
-                format!("{}: must be from 1 to {}", self.max_triangles, u32::MAX),
-            ));
-        }
-        if !(4..=20).contains(&self.max_grid_depth) {
-            return Err(Error::param("max_grid_depth", format!("{}: must be from 4 to 20", self.max_grid_depth)));
-        }
-        if !(self.trim.is_finite() && self.trim >= 0.0) {
-            return Err(Error::param("trim", format!("{}: must be a finite number >= 0", self.trim)));
-        }
-        Ok(())
-    }
-}
-
-/// Why the refinement loop ended.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum RefinementStop {
-    /// error(M, S) reached `target_distance`.
-    Target,
-    /// A level displaced fewer than `min_displaced` of its new vertices: the quadtrees have
-    /// no detail left.
-    #[default]
-    NoDetail,
-    /// `max_levels` levels were done.
-    MaxLevels,
-    /// The next level would have exceeded `max_triangles`: the target asks for more triangles
-    /// than allowed (raise `max_triangles` or the target, or lower the tree's bound).
-    TriangleBudget,
-}
-
-impl RefinementStop {
-    /// Every reason.
-    /// cbindgen:ignore
-    pub const ALL: [RefinementStop; 4] =
-        [RefinementStop::Target, RefinementStop::NoDetail, RefinementStop::MaxLevels, RefinementStop::TriangleBudget];
-
-    /// The reason's name: "target", "no_detail", "max_levels" or "triangle_budget". The CLI
-    /// prints it, the C API gives it (vstree_refinement_stopped_str()), and the Python
-    /// bindings put it in their statistics.
-    pub fn as_str(self) -> &'static str {
-        // The names are ASCII, so never "".
-        self.as_c_str().to_str().unwrap_or_default()
-    }
-
-    /// [`RefinementStop::as_str`] as a static C string, for the C API.
-    pub fn as_c_str(self) -> &'static CStr {
-        match self {
-            RefinementStop::Target => c"target",
-            RefinementStop::NoDetail => c"no_detail",
-            RefinementStop::MaxLevels => c"max_levels",
-            RefinementStop::TriangleBudget => c"triangle_budget",
-        }
-    }
-}
-
-/// What [`reconstruct`] did.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct ReconstructStats {
-    /// What was done to the normals.
-    pub normals: NormalsReport,
-    pub tree: TreeStats,
-    /// Cells across the polygonisation grid (a power of two).
-    pub grid_cells: u32,
-    pub fine_triangles: usize,
-    /// The polygonisation was thickened (see the `reconstruct` module): the plain one had
-    /// handles that vanished once parts thinner than the grid were thickened.
-    pub thickened: bool,
-    /// Share of the polygonised closed surface's area no sample supports: farther than the
-    /// support's reach from every sample, or near only samples facing the other way (about
-    /// half for a scan from one side).
-    pub unsupported_share: f64,
-    /// The output is the supported part only (see [`Closure`]).
-    pub open: bool,
-    /// Edges of M0 with one face (0 when M0 is closed).
-    pub base_boundary_edges: usize,
-    pub base_vertices: usize,
-    pub base_triangles: usize,
-    /// Genus of M0 when it is a closed manifold.
-    pub base_genus: Option<u32>,
-    pub levels: Vec<LevelStats>,
-    /// Why refinement ended.
-    pub stopped: RefinementStop,
-    /// error(M, S) of M0 and of the final mesh: RMS and max sample-to-mesh distance over the
-    /// diagonal.
-    pub base_error: f64,
-    pub final_error: f64,
-    pub final_max_error: f64,
-    pub trimmed_triangles: usize,
-    pub output_vertices: usize,
-    pub output_triangles: usize,
-    pub seconds_normals: f64,
-    pub seconds_tree: f64,
-    pub seconds_base: f64,
-    pub seconds_refine: f64,
-    pub seconds_trim: f64,
-}
 
 /// The error for a tree without T-nodes, naming the parameter that stopped it short of the
 /// surface: every leaf is then an octree cell, left unsplit because it was at the deepest
@@ -612,11 +418,11 @@ pub fn reconstruct(
     };
     if stats.open {
         // An explicit `trim` removes every face farther than it. Otherwise the border is cut
-        // back to BORDER_TRIM sample spacings past the last samples (see `trim_border`).
+        // back to BORDER_TRIM sample spacings past the last samples (see `trim::border`).
         stats.trimmed_triangles = if params.trim > 0.0 {
-            trim_far_faces(&mut mesh, &sample_index, params.trim * grid.cell, &threads)
+            trim::far_faces(&mut mesh, &sample_index, params.trim * grid.cell, &threads)
         } else {
-            trim_border(&mut mesh, &sample_index, BORDER_TRIM * spacing, &threads)
+            trim::border(&mut mesh, &sample_index, BORDER_TRIM * spacing, &threads)
         };
     }
     stats.seconds_trim = t3.elapsed().as_secs_f64();
@@ -823,107 +629,9 @@ pub(super) fn renumber_used_vertices(triangles: &mut [[u32; 3]], vertices: usize
     kept
 }
 
-/// Removes the faces whose centroid is farther than `distance` from every sample; how many.
-fn trim_far_faces(mesh: &mut Mesh, samples: &KdTree, distance: f32, threads: &Threads) -> usize {
-    let far: Vec<bool> = threads.run(|| {
-        mesh.triangles
-            .par_iter()
-            .map(|t| {
-                let centre = t.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / 3.0;
-                !samples.any_within(centre, distance)
-            })
-            .collect()
-    });
-    let before = mesh.triangles.len();
-    remove_faces(mesh, &far);
-    before - mesh.triangles.len()
-}
-
-/// Cuts an open output's border back to `distance` from the samples; how many faces went.
-/// The polygonisation carries the border past the last samples by up to the support's reach.
-/// Faces whose corners are all farther than `distance` go where they reach the border
-/// (farther inside, the surface only strays from sparse or noisy samples, and a hole there
-/// would be wrong); then each border corner still farther slides along the surface towards
-/// its near neighbours until it is `distance` away. Removing faces alone leaves the border
-/// ragged by a face's size, which is many sample spacings on a smooth, densely sampled part.
-fn trim_border(mesh: &mut Mesh, samples: &KdTree, distance: f32, threads: &Threads) -> usize {
-    let near = |p: Vec3| samples.any_within(p, distance);
-    let vertex_near: Vec<bool> = threads.run(|| mesh.positions.par_iter().map(|&p| near(p)).collect());
-    let far: Vec<bool> = mesh.triangles.iter().map(|t| t.iter().all(|&v| !vertex_near[v as usize])).collect();
-    let (region, regions) = support::regions(mesh, &far);
-    let cut: Vec<bool> = region.iter().map(|&r| r != u32::MAX && regions[r as usize].touches_border).collect();
-    let before = mesh.triangles.len();
-    let kept = remove_faces(mesh, &cut);
-    let removed = before - mesh.triangles.len();
-    let vertex_near: Vec<bool> = kept.iter().map(|&v| vertex_near[v]).collect();
-    let border = topology::border_vertices(&mesh.triangles, mesh.positions.len());
-    let neighbours = adjacency::Rows::neighbours(&mesh.triangles, mesh.positions.len());
-    let moved: Vec<(usize, Vec3)> = threads.run(|| {
-        (0..mesh.positions.len())
-            .into_par_iter()
-            .filter(|&v| border[v] && !vertex_near[v])
-            .filter_map(|v| {
-                let inner: Vec<Vec3> = neighbours
-                    .of(v as u32)
-                    .iter()
-                    .filter(|&&w| vertex_near[w as usize])
-                    .map(|&w| mesh.positions[w as usize])
-                    .collect();
-                if inner.is_empty() {
-                    return None;
-                }
-                let (from, to) = (mesh.positions[v], inner.iter().sum::<Vec3>() / inner.len() as f32);
-                // Bisection on the segment for where it comes within `distance`.
-                let (mut out, mut inside) = (0.0f32, 1.0f32);
-                for _ in 0..BORDER_SLIDE_STEPS {
-                    let mid = 0.5 * (out + inside);
-                    if near(from.lerp(to, mid)) {
-                        inside = mid;
-                    } else {
-                        out = mid;
-                    }
-                }
-                Some((v, from.lerp(to, inside)))
-            })
-            .collect()
-    });
-    for (v, p) in moved {
-        mesh.positions[v] = p;
-    }
-    removed
-}
-
-/// Removes the faces `gone` marks, and the vertices left unused; the old index of each vertex
-/// kept.
-fn remove_faces(mesh: &mut Mesh, gone: &[bool]) -> Vec<usize> {
-    let mut g = gone.iter();
-    mesh.triangles.retain(|_| !*g.next().unwrap_or(&false));
-    let kept = renumber_used_vertices(&mut mesh.triangles, mesh.positions.len());
-    mesh.positions = kept.iter().map(|&v| mesh.positions[v]).collect();
-    mesh.normals = mesh.normals.as_ref().map(|n| kept.iter().map(|&v| n[v]).collect());
-    kept
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_border_is_cut_back_to_the_samples_not_a_face_short_of_them() {
-        // Faces 0.1 wide over [0, 1]², samples on x <= 0.43 only: the border goes to 0.45
-        // (0.02 past the samples) on the whole right side, where removing faces alone would
-        // leave it at 0.4 or 0.5.
-        let mut mesh = crate::eval::shapes::square_grid(10);
-        let samples: Vec<Vec3> =
-            (0..=43).flat_map(|i| (0..=100).map(move |j| Vec3::new(i as f32 * 0.01, j as f32 * 0.01, 0.0))).collect();
-        let near = KdTree::new(&samples).unwrap();
-        let removed = trim_border(&mut mesh, &near, 0.02, &Threads::new(1).unwrap());
-        assert_eq!(removed, 100, "the five columns of faces wholly past 0.45");
-        let right = mesh.positions.iter().map(|p| p.x).fold(0.0f32, f32::max);
-        assert!((right - 0.45).abs() < 0.005, "border at x = {right}");
-        let on_border = mesh.positions.iter().filter(|p| p.x > 0.44).count();
-        assert_eq!(on_border, 11, "every vertex of the column past the samples slid back");
-    }
 
     #[test]
     fn duplicate_points_do_not_make_the_spacing_zero() {

@@ -1,0 +1,202 @@
+//! What [`super::reconstruct`] is asked ([`ReconstructParams`]) and what it reports
+//! ([`ReconstructStats`], [`RefinementStop`]).
+
+/// What decides inside and outside for the base mesh.
+use super::{refine::LevelStats, support::Closure};
+use crate::error::{Error, Result};
+use crate::normals::{NormalParams, NormalsReport};
+use crate::tree::{TreeKind, TreeParams, TreeStats};
+use std::ffi::CStr;
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BaseMesh {
+    /// The samples' winding number gives the side everywhere, the distance to the nearest
+    /// sample the value. The winding number is a property of the whole cloud, so the topology
+    /// does not depend on how large the T-nodes near a thin part or a narrow gap are, and the
+    /// distance keeps details down to the sample spacing. The default.
+    #[default]
+    Winding,
+    /// The paper's §5.2: the T-nodes' planes blended by a partition of unity near the samples
+    /// (the winding number only decides beyond them). Kept to compare with.
+    Paper,
+}
+
+/// Parameters of [`super::reconstruct`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReconstructParams {
+    /// The tree: its L2 bound smooths noise (larger = smoother, fewer details); `d_a`/`d_d`
+    /// set how deep the T-layer goes, i.e. how dense M0 is where curvature is high.
+    pub tree: TreeParams,
+    /// Stop refining once error(M, S) (RMS distance over the diagonal) is at most this.
+    /// 0 = refine until the quadtrees have no detail left or `max_levels`.
+    pub target_distance: f64,
+    /// Most refinement levels (each multiplies the triangle count by 4). 0-12.
+    pub max_levels: u32,
+    /// A level that displaces fewer than this fraction of its new vertices ends refinement:
+    /// the quadtrees have no detail left for further levels. In [0, 1].
+    pub min_displaced: f64,
+    /// No level is started that would exceed this many triangles.
+    pub max_triangles: usize,
+    /// The polygonisation grid is as fine as the deepest T-node, but never finer than
+    /// 2^`max_grid_depth` cells across. 4-20.
+    pub max_grid_depth: u32,
+    /// Remove faces farther than this many grid cells from every sample (open scans give
+    /// open meshes); 0 keeps the closed surface. Above 0 the input is taken to be open, and
+    /// the closing sheet behind it is placed farther back, so that it is trimmed away.
+    pub trim: f32,
+    /// Open or closed output: by default (`Auto`) open where much of the closed surface is far
+    /// from every sample (a scan from one side), closed otherwise (holes closed over); `Open`
+    /// keeps only the part of the surface the samples support (a scan's holes too), `Closed`
+    /// always closes.
+    pub closure: Closure,
+    /// How the base mesh's inside and outside are decided.
+    pub base_mesh: BaseMesh,
+    /// Normals: estimated where the cloud has none (PCA over neighbours, oriented by spanning
+    /// tree propagation, turned outward); the cloud's own are kept unless
+    /// `normals.reorient_given`.
+    pub normals: NormalParams,
+    /// Worker threads; 0 = all cores.
+    pub threads: usize,
+}
+
+impl Default for ReconstructParams {
+    fn default() -> Self {
+        ReconstructParams {
+            tree: TreeParams { error: 1e-5, ..TreeParams::default() },
+            target_distance: 0.0,
+            max_levels: 6,
+            min_displaced: 0.02,
+            max_triangles: 20_000_000,
+            max_grid_depth: 10,
+            trim: 0.0,
+            closure: Closure::Auto,
+            base_mesh: BaseMesh::Winding,
+            normals: NormalParams::default(),
+            threads: 0,
+        }
+    }
+}
+
+impl ReconstructParams {
+    /// Rejects values outside their documented ranges, naming the parameter.
+    pub fn check(&self) -> Result<()> {
+        self.tree.check()?;
+        // Even when the cloud's own normals are kept: a value outside the range is a mistake.
+        self.normals.check()?;
+        if self.tree.kind != TreeKind::VsTree {
+            return Err(Error::param(
+                "tree_kind",
+                "octree: reconstruction needs the VS-Tree, whose T-nodes make the base mesh (the octree is \
+                 for simplification)",
+            ));
+        }
+        if !(self.target_distance.is_finite() && self.target_distance >= 0.0) {
+            return Err(Error::param(
+                "target_distance",
+                format!("{}: must be a finite number >= 0", self.target_distance),
+            ));
+        }
+        if self.max_levels > 12 {
+            return Err(Error::param("max_levels", format!("{}: must be from 0 to 12", self.max_levels)));
+        }
+        if !(0.0..=1.0).contains(&self.min_displaced) {
+            return Err(Error::param("min_displaced", format!("{}: must be in [0, 1]", self.min_displaced)));
+        }
+        if self.max_triangles == 0 || self.max_triangles > u32::MAX as usize {
+            return Err(Error::param(
+                "max_triangles",
+                format!("{}: must be from 1 to {}", self.max_triangles, u32::MAX),
+            ));
+        }
+        if !(4..=20).contains(&self.max_grid_depth) {
+            return Err(Error::param("max_grid_depth", format!("{}: must be from 4 to 20", self.max_grid_depth)));
+        }
+        if !(self.trim.is_finite() && self.trim >= 0.0) {
+            return Err(Error::param("trim", format!("{}: must be a finite number >= 0", self.trim)));
+        }
+        Ok(())
+    }
+}
+
+/// Why the refinement loop ended.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RefinementStop {
+    /// error(M, S) reached `target_distance`.
+    Target,
+    /// A level displaced fewer than `min_displaced` of its new vertices: the quadtrees have
+    /// no detail left.
+    #[default]
+    NoDetail,
+    /// `max_levels` levels were done.
+    MaxLevels,
+    /// The next level would have exceeded `max_triangles`: the target asks for more triangles
+    /// than allowed (raise `max_triangles` or the target, or lower the tree's bound).
+    TriangleBudget,
+}
+
+impl RefinementStop {
+    /// Every reason.
+    /// cbindgen:ignore
+    pub const ALL: [RefinementStop; 4] =
+        [RefinementStop::Target, RefinementStop::NoDetail, RefinementStop::MaxLevels, RefinementStop::TriangleBudget];
+
+    /// The reason's name: "target", "no_detail", "max_levels" or "triangle_budget". The CLI
+    /// prints it, the C API gives it (vstree_refinement_stopped_str()), and the Python
+    /// bindings put it in their statistics.
+    pub fn as_str(self) -> &'static str {
+        // The names are ASCII, so never "".
+        self.as_c_str().to_str().unwrap_or_default()
+    }
+
+    /// [`RefinementStop::as_str`] as a static C string, for the C API.
+    pub fn as_c_str(self) -> &'static CStr {
+        match self {
+            RefinementStop::Target => c"target",
+            RefinementStop::NoDetail => c"no_detail",
+            RefinementStop::MaxLevels => c"max_levels",
+            RefinementStop::TriangleBudget => c"triangle_budget",
+        }
+    }
+}
+
+/// What [`super::reconstruct`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ReconstructStats {
+    /// What was done to the normals.
+    pub normals: NormalsReport,
+    pub tree: TreeStats,
+    /// Cells across the polygonisation grid (a power of two).
+    pub grid_cells: u32,
+    pub fine_triangles: usize,
+    /// The polygonisation was thickened (see the `reconstruct` module): the plain one had
+    /// handles that vanished once parts thinner than the grid were thickened.
+    pub thickened: bool,
+    /// Share of the polygonised closed surface's area no sample supports: farther than the
+    /// support's reach from every sample, or near only samples facing the other way (about
+    /// half for a scan from one side).
+    pub unsupported_share: f64,
+    /// The output is the supported part only (see [`Closure`]).
+    pub open: bool,
+    /// Edges of M0 with one face (0 when M0 is closed).
+    pub base_boundary_edges: usize,
+    pub base_vertices: usize,
+    pub base_triangles: usize,
+    /// Genus of M0 when it is a closed manifold.
+    pub base_genus: Option<u32>,
+    pub levels: Vec<LevelStats>,
+    /// Why refinement ended.
+    pub stopped: RefinementStop,
+    /// error(M, S) of M0 and of the final mesh: RMS and max sample-to-mesh distance over the
+    /// diagonal.
+    pub base_error: f64,
+    pub final_error: f64,
+    pub final_max_error: f64,
+    pub trimmed_triangles: usize,
+    pub output_vertices: usize,
+    pub output_triangles: usize,
+    pub seconds_normals: f64,
+    pub seconds_tree: f64,
+    pub seconds_base: f64,
+    pub seconds_refine: f64,
+    pub seconds_trim: f64,
+}
