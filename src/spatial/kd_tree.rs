@@ -101,6 +101,29 @@ fn split_node(entries: &mut [Entry]) -> Split {
     Split { value: entries[mid].p[axis], axis: axis as u32 }
 }
 
+/// A node of the tree during a search: its points `begin..end`, and per axis a lower bound of
+/// the distance from the query to its cell.
+#[derive(Clone, Copy)]
+struct Cell {
+    node: usize,
+    begin: usize,
+    end: usize,
+    offset: [f32; 3],
+}
+
+impl Cell {
+    fn root(len: usize) -> Cell {
+        Cell { node: 0, begin: 0, end: len, offset: [0.0; 3] }
+    }
+
+    /// The squared lower bound of the distance from the query to the cell.
+    #[inline(always)]
+    fn bound(&self) -> f32 {
+        let [x, y, z] = self.offset;
+        x * x + y * y + z * z
+    }
+}
+
 /// The k best candidates so far, sorted by (distance, index).
 struct Best {
     k: usize,
@@ -383,25 +406,15 @@ impl KdTree {
             return None;
         }
         let mut best = Nearest { d2: below, id: None, enough };
-        self.visit_nearest(0, 0, self.entries.len(), p.to_array(), [0.0; 3], keep, &mut best);
+        self.visit_nearest(Cell::root(self.entries.len()), p.to_array(), keep, &mut best);
         best.id.map(|id| (best.d2, id))
     }
 
     /// [`KdTree::visit`] for a single nearest point; true once a point within `best.enough`
     /// is found, which ends the search.
-    #[allow(clippy::too_many_arguments)]
-    fn visit_nearest(
-        &self,
-        node: usize,
-        begin: usize,
-        end: usize,
-        q: [f32; 3],
-        offset: [f32; 3],
-        keep: &impl Fn(u32) -> bool,
-        best: &mut Nearest,
-    ) -> bool {
-        if node >= self.splits.len() {
-            for e in &self.entries[begin..end] {
+    fn visit_nearest(&self, cell: Cell, q: [f32; 3], keep: &impl Fn(u32) -> bool, best: &mut Nearest) -> bool {
+        if cell.node >= self.splits.len() {
+            for e in &self.entries[cell.begin..cell.end] {
                 let d2 = dist2(q, e.p);
                 if best.beaten_by(d2, e.id) && keep(e.id) {
                     (best.d2, best.id) = (d2, Some(e.id));
@@ -412,36 +425,20 @@ impl KdTree {
             }
             return false;
         }
-        let Split { value, axis } = self.splits[node];
-        let axis = axis as usize;
-        let mid = begin + (end - begin) / 2;
-        let diff = q[axis] - value;
-        let (near, far) = if diff <= 0.0 {
-            ((2 * node + 1, begin, mid), (2 * node + 2, mid, end))
-        } else {
-            ((2 * node + 2, mid, end), (2 * node + 1, begin, mid))
-        };
-        if self.visit_nearest(near.0, near.1, near.2, q, offset, keep, best) {
-            return true;
-        }
-        let mut far_offset = offset;
-        far_offset[axis] = far_offset[axis].max(diff.abs());
-        let [x, y, z] = far_offset;
-        x * x + y * y + z * z <= best.d2 && self.visit_nearest(far.0, far.1, far.2, q, far_offset, keep, best)
+        let (near, far) = self.children(cell, q);
+        self.visit_nearest(near, q, keep, best) || (far.bound() <= best.d2 && self.visit_nearest(far, q, keep, best))
     }
 
     /// Fills `best` with the nearest points to `q`, leaving out tree position `skip`.
     fn search(&self, q: [f32; 3], skip: u32, best: &mut Best) {
-        self.visit(0, 0, self.entries.len(), q, [0.0; 3], skip, best);
+        self.visit(Cell::root(self.entries.len()), q, skip, best);
     }
 
-    /// Searches node `node` (points `begin..end`); `offset` holds, per axis, a lower bound of
-    /// the distance from `q` to the node's cell.
-    #[allow(clippy::too_many_arguments)]
-    fn visit(&self, node: usize, begin: usize, end: usize, q: [f32; 3], offset: [f32; 3], skip: u32, best: &mut Best) {
-        if node >= self.splits.len() {
-            for (position, e) in self.entries[begin..end].iter().enumerate() {
-                let position = (begin + position) as u32;
+    /// Searches `cell`'s points.
+    fn visit(&self, cell: Cell, q: [f32; 3], skip: u32, best: &mut Best) {
+        if cell.node >= self.splits.len() {
+            for (position, e) in self.entries[cell.begin..cell.end].iter().enumerate() {
+                let position = (cell.begin + position) as u32;
                 if position != skip {
                     let d2 = dist2(q, e.p);
                     if d2 <= best.bound() {
@@ -451,25 +448,28 @@ impl KdTree {
             }
             return;
         }
-        let Split { value, axis } = self.splits[node];
-        let axis = axis as usize;
-        let mid = begin + (end - begin) / 2;
-        let diff = q[axis] - value;
-        let (near, far) = if diff <= 0.0 {
-            ((2 * node + 1, begin, mid), (2 * node + 2, mid, end))
-        } else {
-            ((2 * node + 2, mid, end), (2 * node + 1, begin, mid))
-        };
-        self.visit(near.0, near.1, near.2, q, offset, skip, best);
-        // Every point across the plane is at least |diff| away along `axis`. Rounding is
-        // monotonic, so the bound never exceeds a true candidate's computed distance, and ties
-        // (equal distance, smaller index) are still visited: the pruning is exact.
-        let mut far_offset = offset;
-        far_offset[axis] = far_offset[axis].max(diff.abs());
-        let [x, y, z] = far_offset;
-        if x * x + y * y + z * z <= best.bound() {
-            self.visit(far.0, far.1, far.2, q, far_offset, skip, best);
+        let (near, far) = self.children(cell, q);
+        self.visit(near, q, skip, best);
+        if far.bound() <= best.bound() {
+            self.visit(far, q, skip, best);
         }
+    }
+
+    /// The two children of inner node `cell`, the one on `q`'s side of the split first. Every
+    /// point across the plane is at least |q - split| away along its axis. Rounding is
+    /// monotonic, so the far child's bound never exceeds a true candidate's computed distance,
+    /// and ties (equal distance, smaller index) are still visited: the pruning is exact.
+    #[inline(always)]
+    fn children(&self, cell: Cell, q: [f32; 3]) -> (Cell, Cell) {
+        let Split { value, axis } = self.splits[cell.node];
+        let axis = axis as usize;
+        let mid = cell.begin + (cell.end - cell.begin) / 2;
+        let diff = q[axis] - value;
+        let left = Cell { node: 2 * cell.node + 1, end: mid, ..cell };
+        let right = Cell { node: 2 * cell.node + 2, begin: mid, ..cell };
+        let (near, mut far) = if diff <= 0.0 { (left, right) } else { (right, left) };
+        far.offset[axis] = far.offset[axis].max(diff.abs());
+        (near, far)
     }
 }
 
