@@ -2,7 +2,7 @@
 //! the call, which gives a new mesh handle (handles are immutable), and its report.
 
 use super::mesh::{into_handle, mesh_ref, vstree_mesh};
-use super::params::{self, one_of, Versioned};
+use super::params::{self, constant_field, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::{guard, non_null, vstree_status, write_out, Failure, FfiResult};
 use crate::mesh::Mesh;
@@ -26,22 +26,24 @@ pub const VSTREE_ORIENTATION_PROPAGATE_OUTWARD: i32 = 3;
 
 /// Reads an `orient` field.
 pub(crate) fn orientation(value: i32) -> FfiResult<Orientation> {
-    let value = one_of(
+    constant_field(
         "orient",
         value,
         &[
-            (VSTREE_ORIENTATION_UNORIENTED, "VSTREE_ORIENTATION_UNORIENTED"),
-            (VSTREE_ORIENTATION_PROPAGATE, "VSTREE_ORIENTATION_PROPAGATE"),
-            (VSTREE_ORIENTATION_PROPAGATE_MAJORITY, "VSTREE_ORIENTATION_PROPAGATE_MAJORITY"),
-            (VSTREE_ORIENTATION_PROPAGATE_OUTWARD, "VSTREE_ORIENTATION_PROPAGATE_OUTWARD"),
+            (VSTREE_ORIENTATION_UNORIENTED, "VSTREE_ORIENTATION_UNORIENTED", Orientation::Unoriented),
+            (VSTREE_ORIENTATION_PROPAGATE, "VSTREE_ORIENTATION_PROPAGATE", Orientation::Propagate),
+            (
+                VSTREE_ORIENTATION_PROPAGATE_MAJORITY,
+                "VSTREE_ORIENTATION_PROPAGATE_MAJORITY",
+                Orientation::PropagateMajority,
+            ),
+            (
+                VSTREE_ORIENTATION_PROPAGATE_OUTWARD,
+                "VSTREE_ORIENTATION_PROPAGATE_OUTWARD",
+                Orientation::PropagateOutward,
+            ),
         ],
-    )?;
-    Ok(match value {
-        VSTREE_ORIENTATION_UNORIENTED => Orientation::Unoriented,
-        VSTREE_ORIENTATION_PROPAGATE => Orientation::Propagate,
-        VSTREE_ORIENTATION_PROPAGATE_MAJORITY => Orientation::PropagateMajority,
-        _ => Orientation::PropagateOutward,
-    })
+    )
 }
 
 /// The C value of an orientation.

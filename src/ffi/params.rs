@@ -55,12 +55,13 @@ pub(crate) unsafe fn read<T: Versioned>(pointer: *const T, argument: &str) -> Ff
     Ok(value)
 }
 
-/// Checks that an enum-like `int32_t` field holds one of `allowed`.
-pub(crate) fn one_of(field: &str, value: i32, allowed: &[(i32, &str)]) -> FfiResult<i32> {
-    if allowed.iter().any(|&(v, _)| v == value) {
-        return Ok(value);
+/// Reads an `int32_t` field that holds one of the header's `#define`d `constants` (value, name,
+/// and what it stands for in Rust); another value fails, naming them all.
+pub(crate) fn constant_field<T: Copy>(field: &str, value: i32, constants: &[(i32, &str, T)]) -> FfiResult<T> {
+    match constants.iter().find(|&&(v, _, _)| v == value) {
+        Some(&(_, _, meaning)) => Ok(meaning),
+        None => Err(not_one_of(field, value, constants.iter().map(|&(v, name, _)| (v, name)))),
     }
-    Err(not_one_of(field, value, allowed.iter().copied()))
 }
 
 /// The failure of a field that holds none of the `allowed` values, naming them all.

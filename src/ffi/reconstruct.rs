@@ -3,7 +3,7 @@
 
 use super::mesh::{mesh_ref, vstree_mesh};
 use super::normals::{flag, orientation, orientation_value, threads};
-use super::params::{self, one_of, Versioned};
+use super::params::{self, constant_field, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::{guard, guard_or, handle, non_null, vstree_status, write_out, FfiResult};
 use crate::normals::NormalParams;
@@ -97,32 +97,30 @@ pub const VSTREE_CLOSURE_OPEN: i32 = 2;
 
 /// Reads a `closure` field.
 fn closure(value: i32) -> FfiResult<Closure> {
-    let value = one_of(
+    constant_field(
         "closure",
         value,
         &[
-            (VSTREE_CLOSURE_AUTO, "VSTREE_CLOSURE_AUTO"),
-            (VSTREE_CLOSURE_CLOSED, "VSTREE_CLOSURE_CLOSED"),
-            (VSTREE_CLOSURE_OPEN, "VSTREE_CLOSURE_OPEN"),
+            (VSTREE_CLOSURE_AUTO, "VSTREE_CLOSURE_AUTO", Closure::Auto),
+            (VSTREE_CLOSURE_CLOSED, "VSTREE_CLOSURE_CLOSED", Closure::Closed),
+            (VSTREE_CLOSURE_OPEN, "VSTREE_CLOSURE_OPEN", Closure::Open),
         ],
-    )?;
-    Ok(match value {
-        VSTREE_CLOSURE_CLOSED => Closure::Closed,
-        VSTREE_CLOSURE_OPEN => Closure::Open,
-        _ => Closure::Auto,
-    })
+    )
 }
 
-/// The C value of a closure.
+/// Reads a `base_mesh` field.
 fn base_mesh(value: i32) -> FfiResult<BaseMesh> {
-    let value = one_of(
+    constant_field(
         "base_mesh",
         value,
-        &[(VSTREE_BASE_MESH_WINDING, "VSTREE_BASE_MESH_WINDING"), (VSTREE_BASE_MESH_PAPER, "VSTREE_BASE_MESH_PAPER")],
-    )?;
-    Ok(if value == VSTREE_BASE_MESH_PAPER { BaseMesh::Paper } else { BaseMesh::Winding })
+        &[
+            (VSTREE_BASE_MESH_WINDING, "VSTREE_BASE_MESH_WINDING", BaseMesh::Winding),
+            (VSTREE_BASE_MESH_PAPER, "VSTREE_BASE_MESH_PAPER", BaseMesh::Paper),
+        ],
+    )
 }
 
+/// The C value of a base mesh.
 fn base_mesh_value(base_mesh: BaseMesh) -> i32 {
     match base_mesh {
         BaseMesh::Winding => VSTREE_BASE_MESH_WINDING,
@@ -130,6 +128,7 @@ fn base_mesh_value(base_mesh: BaseMesh) -> i32 {
     }
 }
 
+/// The C value of a closure.
 fn closure_value(closure: Closure) -> i32 {
     match closure {
         Closure::Auto => VSTREE_CLOSURE_AUTO,
