@@ -3,6 +3,7 @@
 
 use crate::mesh::Mesh;
 use crate::topology::{edges_and_face_counts, is_valid_face};
+use glam::DVec3;
 
 /// The valence (number of distinct neighbours along edges) of every vertex in `positions`;
 /// unreferenced vertices have valence 0. Degenerate faces are ignored.
@@ -30,35 +31,26 @@ pub fn valence_histogram(mesh: &Mesh) -> Vec<u32> {
     histogram
 }
 
-/// The signed volume enclosed by the triangles (sum of the signed tetrahedra from the origin), in
-/// double precision. Positive for a closed mesh with outward (counter-clockwise seen from
-/// outside) winding. Faces with out-of-range indices are skipped.
-pub fn signed_volume(mesh: &Mesh) -> f64 {
+/// The corners, in double precision, of every triangle whose indices are in range.
+fn corners(mesh: &Mesh) -> impl Iterator<Item = [DVec3; 3]> + '_ {
     let p = &mesh.positions;
     mesh.triangles
         .iter()
         .filter(|tri| tri.iter().all(|&v| (v as usize) < p.len()))
-        .map(|&[a, b, c]| {
-            let (a, b, c) = (p[a as usize].as_dvec3(), p[b as usize].as_dvec3(), p[c as usize].as_dvec3());
-            a.dot(b.cross(c))
-        })
-        .sum::<f64>()
-        / 6.0
+        .map(|tri| tri.map(|v| p[v as usize].as_dvec3()))
+}
+
+/// The signed volume enclosed by the triangles (sum of the signed tetrahedra from the origin), in
+/// double precision. Positive for a closed mesh with outward (counter-clockwise seen from
+/// outside) winding. Faces with out-of-range indices are skipped.
+pub fn signed_volume(mesh: &Mesh) -> f64 {
+    corners(mesh).map(|[a, b, c]| a.dot(b.cross(c))).sum::<f64>() / 6.0
 }
 
 /// The total area of the triangles, in double precision. Faces with out-of-range indices are
 /// skipped.
 pub fn surface_area(mesh: &Mesh) -> f64 {
-    let p = &mesh.positions;
-    mesh.triangles
-        .iter()
-        .filter(|tri| tri.iter().all(|&v| (v as usize) < p.len()))
-        .map(|&[a, b, c]| {
-            let a = p[a as usize].as_dvec3();
-            (p[b as usize].as_dvec3() - a).cross(p[c as usize].as_dvec3() - a).length()
-        })
-        .sum::<f64>()
-        / 2.0
+    corners(mesh).map(|[a, b, c]| (b - a).cross(c - a).length()).sum::<f64>() / 2.0
 }
 
 #[cfg(test)]
