@@ -84,7 +84,7 @@ pub(super) fn border(mesh: &mut Mesh, samples: &KdTree, distance: f32, threads: 
 
 /// Removes the faces `gone` marks, and the vertices left unused; the old index of each vertex
 /// kept.
-pub(super) fn remove_faces(mesh: &mut Mesh, gone: &[bool]) -> Vec<usize> {
+fn remove_faces(mesh: &mut Mesh, gone: &[bool]) -> Vec<usize> {
     let mut g = gone.iter();
     mesh.triangles.retain(|_| !*g.next().unwrap_or(&false));
     let kept = renumber_used_vertices(&mut mesh.triangles, mesh.positions.len());
