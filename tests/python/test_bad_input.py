@@ -400,9 +400,9 @@ ARRAY_CASES = [
     case("positions-objects", mesh_of([[0, 0, {}]]), TypeError, None,
          "positions: float() argument must be a string or a real number, not 'dict'"),
     case("positions-empty", mesh_of(np.zeros((0, 3))), vstree.VstreeError, INPUT,
-         "vstree_mesh_create: `vertex_count` is 0: a mesh needs at least one vertex"),
+         "vstree_mesh_create_f64: `vertex_count` is 0: a mesh needs at least one vertex"),
     case("positions-empty-list", mesh_of([]), vstree.VstreeError, INPUT,
-         "vstree_mesh_create: `vertex_count` is 0: a mesh needs at least one vertex"),
+         "vstree_mesh_create_f64: `vertex_count` is 0: a mesh needs at least one vertex"),
     case("positions-nan", mesh_of(with_item(P, (5, 1), np.nan), T), vstree.VstreeError, INPUT,
          "vstree_mesh_create: invalid input: vertex 5 has a NaN or infinite coordinate"),
     case("positions-inf", mesh_of(with_item(P, (7, 0), np.inf), T), vstree.VstreeError, INPUT,
@@ -414,8 +414,14 @@ ARRAY_CASES = [
          "magnitude is supported (32-bit geometry); rescale the input"),
     case("positions-float64-beyond-float32", mesh_of(with_item(P.astype(np.float64), (12, 2), -1e300), T),
          vstree.VstreeError, INPUT,
-         "vstree.Mesh: invalid input: vertex 12 has a coordinate of -1e+300: at most 1e18 in "
+         "vstree_mesh_create_f64: invalid input: vertex 12 has a coordinate of 1e300: at most 1e18 in "
          "magnitude is supported (32-bit geometry); rescale the input"),
+    case("positions-float64-nan", mesh_of(with_item(P.astype(np.float64) + 1e6, (5, 1), np.nan), T),
+         vstree.VstreeError, INPUT, "vstree_mesh_create_f64: invalid input: vertex 5 has a NaN or infinite "
+         "coordinate (1000000.7878679633, NaN, 999999.7878679633)"),
+    case("positions-float64-beyond-1e18", mesh_of(with_item(P.astype(np.float64), (11, 0), -2e18), T),
+         vstree.VstreeError, INPUT, "vstree_mesh_create_f64: invalid input: vertex 11 has a coordinate of 2e18: "
+         "at most 1e18 in magnitude is supported (32-bit geometry); rescale the input"),
     case("triangles-negative", mesh_of(P, T.astype(np.int64) - 1), ValueError, None,
          "triangle 0 uses vertex -1: indices must be in [0, 2^32 - 1]"),
     case("triangles-beyond-uint32", mesh_of(P, with_item(T.astype(np.int64), (3, 2), 2**33)), ValueError, None,
@@ -447,7 +453,7 @@ ARRAY_CASES = [
     case("reconstruct-mesh-and-normals", lambda c: vstree.reconstruct(vstree.Mesh(CLOUD), CLOUD), ValueError, None,
          "normals are given with the Mesh, not separately"),
     case("reconstruct-no-points", lambda c: vstree.reconstruct(np.zeros((0, 3))), vstree.VstreeError, INPUT,
-         "vstree_mesh_create: `vertex_count` is 0: a mesh needs at least one vertex"),
+         "vstree_mesh_create_f64: `vertex_count` is 0: a mesh needs at least one vertex"),
     case("reconstruct-five-points", lambda c: vstree.reconstruct(CLOUD[:5]), vstree.VstreeError, INPUT,
          "vstree_reconstruct: invalid input: 5 points: at least 10 are needed"),
     case("reconstruct-points-on-a-line", lambda c: vstree.reconstruct(LINE), vstree.VstreeError, INPUT,

@@ -466,3 +466,24 @@ def test_a_model_far_from_the_origin_keeps_its_detail(tmp_path):
     assert simplified.vertex_count == reference.vertex_count
     # The same clusters (at 1e8 in float32 alone they would be 4 units off).
     np.testing.assert_allclose(simplified.positions_f64 - 1e8, reference.positions_f64, rtol=0, atol=1e-5)
+
+
+# ---- float64 input ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("offset", [1e6, 1e7, 1e8])
+def test_float64_positions_far_from_the_origin_are_kept_as_a_file_keeps_them(offset):
+    # A unit sphere 1e6 to 1e8 away: float32 coordinates there are 1/16 to 8 apart, so it came
+    # back with radius errors of 0.24 at 1e6 and as one point at 1e7 and beyond.
+    sphere = fibonacci_sphere(3000).astype(np.float64)
+    far = sphere + offset
+    mesh = vstree.Mesh(far, None, sphere)
+    # The readers' rule: relative to the box's centre rounded to float32, in float32.
+    origin = ((far.min(0) + far.max(0)) / 2).astype(np.float32).astype(np.float64)
+    expected = (far - origin).astype(np.float32).astype(np.float64) + origin
+    np.testing.assert_array_equal(mesh.positions_f64, expected)
+    radius_error = np.abs(np.linalg.norm(mesh.positions_f64 - offset, axis=1) - 1).max()
+    assert radius_error < 1e-6, radius_error
+    # float32 input keeps the float32 path: stored as given.
+    as_float32 = far.astype(np.float32)
+    np.testing.assert_array_equal(vstree.Mesh(as_float32).positions_f64, as_float32.astype(np.float64))

@@ -114,20 +114,28 @@ class Mesh:
     ``positions``: (n, 3) array-like of floats; ``triangles``: (m, 3) array-like of vertex
     indices (None or empty for a point cloud); ``normals``: None or (n, 3) floats. The arrays
     are copied into the library.
+
+    float32 positions are used as they are. Any others (float64, integers, lists) are read in
+    double precision and kept as a file's are: a model far from the origin for its size
+    (georeferenced coordinates at 1e6 or 1e8) is stored relative to its own centre, so its
+    detail survives and :attr:`positions_f64` gives it back.
     """
 
     __slots__ = ("_handle",)
 
     def __init__(self, positions, triangles=None, normals=None):
-        p = _as_rows(positions, np.float32, "positions")
+        p = _as_rows(positions, None, "positions")
         n = None if normals is None else _as_rows(normals, np.float32, "normals")
         if n is not None and n.shape != p.shape:
             raise ValueError("normals has shape %s, positions %s" % (n.shape, p.shape))
         t = np.zeros((0, 3), np.uint32) if triangles is None else _as_indices(triangles)
+        create, pointer = (
+            (lib.vstree_mesh_create, _ffi._F32P) if p.dtype == np.float32 else (lib.vstree_mesh_create_f64, _ffi._F64P)
+        )
         handle = ctypes.c_void_p()
         _check(
-            lib.vstree_mesh_create(
-                p.ctypes.data_as(_ffi._F32P),
+            create(
+                p.ctypes.data_as(pointer),
                 p.shape[0],
                 None if n is None else n.ctypes.data_as(_ffi._F32P),
                 t.ctypes.data_as(_ffi._U32P),
@@ -272,13 +280,16 @@ def _rows(a, array, name):
 
 
 def _as_rows(array, dtype, name):
-    """(n, 3) float32 rows of ``positions`` or ``normals``. Refused here, with the array's name:
-    None, strings, complex numbers (numpy would drop the imaginary part), objects that do not
-    convert, and finite values too large for float32 (the library would see infinities)."""
+    """(n, 3) rows of ``positions`` or ``normals`` in ``dtype``; None for positions: float32
+    stays float32, anything else becomes float64. Refused here, with the array's name: None,
+    strings, complex numbers (numpy would drop the imaginary part), objects that do not
+    convert, and finite values too large for ``dtype`` (the library would see infinities)."""
     if array is None:
         raise TypeError("%s must be an (n, 3) array of numbers, not None" % name)
     try:  # ragged lists, objects that are not numbers: numpy's reason, with the array's name
         source = np.asarray(array)
+        if dtype is None:
+            dtype = np.float32 if source.dtype == np.float32 else np.float64
         if source.dtype.kind not in "USc":
             with np.errstate(over="ignore"):  # overflow is reported below, with the vertex
                 a = np.ascontiguousarray(source, dtype=dtype)
