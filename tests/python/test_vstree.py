@@ -2,7 +2,9 @@
 status and message, progress that cancels, exceptions through callbacks, the tree for viewers,
 threads, library lookup and the ABI check."""
 
+import copy
 import os
+import pickle
 import re
 import subprocess
 import sys
@@ -487,3 +489,83 @@ def test_float64_positions_far_from_the_origin_are_kept_as_a_file_keeps_them(off
     # float32 input keeps the float32 path: stored as given.
     as_float32 = far.astype(np.float32)
     np.testing.assert_array_equal(vstree.Mesh(as_float32).positions_f64, as_float32.astype(np.float64))
+
+
+# ---- copies and pickles ----------------------------------------------------------------------
+
+
+def _same_mesh(a, b):
+    np.testing.assert_array_equal(a.positions_f64, b.positions_f64)
+    np.testing.assert_array_equal(a.triangles, b.triangles)
+    if a.normals is None:
+        assert b.normals is None
+    else:
+        np.testing.assert_array_equal(a.normals, b.normals)
+
+
+COPIES = {
+    "copy": copy.copy,
+    "deepcopy": copy.deepcopy,
+    "pickle": lambda m: pickle.loads(pickle.dumps(m)),
+}
+
+
+@pytest.mark.parametrize("how", sorted(COPIES))
+def test_a_copied_or_pickled_mesh_is_an_independent_equal_mesh(shape, how):
+    mesh = vstree.Mesh(*shape)
+    p, t, n = torus(16, 8)
+    far = vstree.Mesh(p.astype(np.float64) + np.array([1e6, -3e7, 1e8]), t, n)
+    for original in (mesh, far, vstree.Mesh(p), vstree.Mesh(p, None, n)):
+        copied = COPIES[how](original)
+        assert copied is not original and copied._handle != original._handle
+        _same_mesh(copied, original)  # exact, far from the origin too
+    source = vstree.Mesh(p, t)
+    copied = COPIES[how](source)
+    source.close()
+    assert copied.vertex_count == len(p)  # its own handle: closing the original leaves it
+    with pytest.raises(ValueError, match="^the mesh was closed$"):
+        COPIES[how](source)
+
+
+TREE_REFUSED = (
+    "vstree.Tree cannot be copied or pickled: it owns a tree in the library, which a copy would share and "
+    "free twice, and a pickle would store only its address; build another with vstree.Tree(mesh, **params), "
+    "or copy or pickle its arrays (stats, nodes, t_nodes, levels, vertex_labels()), which are plain Python and "
+    "numpy objects"
+)
+
+
+@pytest.mark.parametrize("how", sorted(COPIES))
+def test_a_tree_refuses_to_be_copied_or_pickled(shape, how):
+    with vstree.Tree(vstree.Mesh(*shape)) as tree:
+        with pytest.raises(TypeError) as e:
+            COPIES[how](tree)
+        assert str(e.value) == TREE_REFUSED
+        assert tree.nodes.size > 0
+
+
+COPY_THEN_DELETE = """
+import copy, gc, pickle
+import vstree
+from test_vstree import torus
+p, t, n = torus(16, 8)
+mesh = vstree.Mesh(p, t, n)
+tree = vstree.Tree(mesh)
+copies = [copy.copy(mesh), copy.deepcopy(mesh), pickle.loads(pickle.dumps(mesh))]
+for how in (copy.copy, copy.deepcopy, pickle.dumps):
+    try:
+        copies.append(how(tree))
+    except TypeError:
+        pass
+del mesh, tree, copies
+gc.collect()
+print("all freed once")
+"""
+
+
+def test_copies_then_deleting_everything_does_not_crash():
+    # Copies that shared the handle freed it twice: a segmentation fault (so in a subprocess).
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([os.path.join(ROOT, "bindings", "python"), os.path.join(ROOT, "tests", "python")])
+    run = subprocess.run([sys.executable, "-c", COPY_THEN_DELETE], env=env, capture_output=True, text=True, timeout=120)
+    assert (run.returncode, run.stdout, run.stderr) == (0, "all freed once\n", "")

@@ -108,7 +108,59 @@ def _path(path):
     return _c_string(path, "path")
 
 
-class Mesh:
+class _Owner:
+    """What :class:`Mesh` and :class:`Tree` share: the library handle each owns, freed by
+    close() or when the object is garbage-collected. A copy that shared the handle would free
+    it twice, and pickle would store a pointer into this process: copy.copy(),
+    copy.deepcopy() and pickle refuse with TypeError unless the class makes a new handle from
+    its data (Mesh does)."""
+
+    __slots__ = ("_handle",)
+    #: The object's name in messages ("mesh"), and what to do instead of copying it.
+    _what = "object"
+    _instead = ""
+
+    def _own(self, handle):
+        self._handle = handle
+
+    def _free(self, handle):
+        raise NotImplementedError
+
+    def close(self):
+        """Frees the library's object now (it is freed when garbage-collected otherwise)."""
+        handle, self._handle = getattr(self, "_handle", None), None
+        if handle:
+            self._free(handle)
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may already be unloaded
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _live(self):
+        """The handle, for every call that uses it; a closed object has none (C would report a
+        NULL pointer instead of saying why)."""
+        handle = getattr(self, "_handle", None)
+        if not handle:
+            raise ValueError("the %s was closed" % self._what)
+        return handle
+
+    def __reduce__(self):
+        name = type(self).__name__
+        raise TypeError(
+            "vstree.%s cannot be copied or pickled: it owns a %s in the library, which a copy would "
+            "share and free twice, and a pickle would store only its address; %s" % (name, self._what, self._instead)
+        )
+
+
+class Mesh(_Owner):
     """A triangle mesh, or a point cloud when it has no triangles; immutable.
 
     ``positions``: (n, 3) array-like of floats; ``triangles``: (m, 3) array-like of vertex
@@ -119,9 +171,13 @@ class Mesh:
     double precision and kept as a file's are: a model far from the origin for its size
     (georeferenced coordinates at 1e6 or 1e8) is stored relative to its own centre, so its
     detail survives and :attr:`positions_f64` gives it back.
+
+    copy.copy(), copy.deepcopy() and pickle make an independent mesh from its arrays
+    (positions in float64, so a model far from the origin is copied exactly).
     """
 
-    __slots__ = ("_handle",)
+    __slots__ = ()
+    _what = "mesh"
 
     def __init__(self, positions, triangles=None, normals=None):
         p = _as_rows(positions, None, "positions")
@@ -143,13 +199,20 @@ class Mesh:
                 ctypes.byref(handle),
             )
         )
-        self._handle = handle.value
+        self._own(handle.value)
 
     @classmethod
     def _wrap(cls, handle):
         mesh = cls.__new__(cls)
-        mesh._handle = handle
+        mesh._own(handle)
         return mesh
+
+    def _free(self, handle):
+        lib.vstree_mesh_free(handle)
+
+    def __reduce__(self):
+        """A new mesh from this one's arrays: what copy and pickle use."""
+        return (Mesh, (self.positions_f64, self.triangles, self.normals))
 
     @classmethod
     def load(cls, path):
@@ -175,32 +238,6 @@ class Mesh:
     def save(self, path, ascii=False):
         """Writes the mesh (format from the extension; atomic: on error the file is unchanged)."""
         _check(lib.vstree_mesh_save(self._live(), _path(path), 1 if ascii else 0))
-
-    def close(self):
-        """Frees the mesh now (it is freed when garbage-collected otherwise)."""
-        handle, self._handle = getattr(self, "_handle", None), None
-        if handle:
-            lib.vstree_mesh_free(handle)
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown: the library may already be unloaded
-            pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def _live(self):
-        """The handle, for every call that uses it; a closed mesh has none (C would report a
-        NULL pointer instead of saying why)."""
-        handle = getattr(self, "_handle", None)
-        if not handle:
-            raise ValueError("the mesh was closed")
-        return handle
 
     @property
     def vertex_count(self):
@@ -520,12 +557,20 @@ def simplify(mesh, progress=None, ratio=None, **params):
     return SimplifyResult(Mesh._wrap(out.value), stats)
 
 
-class Tree:
+class Tree(_Owner):
     """The tree :func:`simplify` would cluster ``mesh`` with (same parameters), for viewers:
     ``stats`` (dict), ``nodes``, ``t_nodes`` (the T-layer with frames), ``levels`` (node
-    counts per depth) as numpy structured arrays, and :meth:`vertex_labels`."""
+    counts per depth) as numpy structured arrays, and :meth:`vertex_labels`.
+
+    A tree cannot be copied or pickled (TypeError): the library has no copy of it and it does
+    not keep its mesh; build another, or copy its arrays, which are numpy arrays."""
 
     NO_INDEX = 0xFFFFFFFF
+    _what = "tree"
+    _instead = (
+        "build another with vstree.Tree(mesh, **params), or copy or pickle its arrays (stats, nodes, "
+        "t_nodes, levels, vertex_labels()), which are plain Python and numpy objects"
+    )
 
     def __init__(self, mesh, progress=None, **params):
         p = _params("vstree.Tree", params)
@@ -533,31 +578,11 @@ class Tree:
         cb = _Progress("vstree.Tree", progress)
         handle = ctypes.c_void_p()
         cb.check(lib.vstree_tree_build(mesh_handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(handle)))
-        self._handle = handle.value
-        self.stats = _struct_dict(lib.vstree_tree_get_stats(self._handle).contents)
+        self._own(handle.value)
+        self.stats = _struct_dict(lib.vstree_tree_get_stats(handle.value).contents)
 
-    def close(self):
-        handle, self._handle = getattr(self, "_handle", None), None
-        if handle:
-            lib.vstree_tree_free(handle)
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown: the library may already be unloaded
-            pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def _live(self):
-        handle = getattr(self, "_handle", None)
-        if not handle:
-            raise ValueError("the tree was closed")
-        return handle
+    def _free(self, handle):
+        lib.vstree_tree_free(handle)
 
     def _copy(self, struct, count, copy):
         handle = self._live()
