@@ -569,3 +569,115 @@ def test_copies_then_deleting_everything_does_not_crash():
     env["PYTHONPATH"] = os.pathsep.join([os.path.join(ROOT, "bindings", "python"), os.path.join(ROOT, "tests", "python")])
     run = subprocess.run([sys.executable, "-c", COPY_THEN_DELETE], env=env, capture_output=True, text=True, timeout=120)
     assert (run.returncode, run.stdout, run.stderr) == (0, "all freed once\n", "")
+
+
+# ---- closing what a running call uses ----------------------------------------------------------
+
+IN_USE = (
+    "Mesh.close: the mesh is in use by %s, which is still running (close() was called from its progress "
+    "callback or from another thread); the library reads it, so it cannot be freed now: close it after the "
+    "call returns"
+)
+CALLS_WITH_PROGRESS = {
+    "vstree.simplify": lambda mesh, progress: vstree.simplify(mesh, progress=progress),
+    "vstree.Tree": lambda mesh, progress: vstree.Tree(mesh, progress=progress),
+    "vstree.reconstruct": lambda mesh, progress: vstree.reconstruct(mesh, progress=progress, max_levels=1),
+    "vstree.estimate_normals": lambda mesh, progress: vstree.estimate_normals(mesh, progress=progress),
+}
+
+
+@pytest.mark.parametrize("who", sorted(CALLS_WITH_PROGRESS))
+def test_closing_the_mesh_from_the_progress_callback_is_refused(who):
+    # The library went on reading the freed mesh (valgrind: hundreds of invalid reads).
+    points = fibonacci_sphere(2000)
+    mesh = vstree.Mesh(points, None, None if who == "vstree.estimate_normals" else points)
+    refused = []
+
+    def progress(fraction, stage):
+        try:
+            mesh.close()
+        except RuntimeError as e:
+            refused.append(str(e))
+        return True
+
+    CALLS_WITH_PROGRESS[who](mesh, progress)
+    assert refused and set(refused) == {IN_USE % who}
+    np.testing.assert_array_equal(mesh.positions, points)  # still open, and whole
+    mesh.close()
+    with pytest.raises(ValueError, match="^the mesh was closed$"):
+        mesh.vertex_count
+
+
+def test_closing_the_mesh_from_the_callback_cancels_when_the_error_is_not_caught(shape):
+    mesh = vstree.Mesh(*shape)
+    with pytest.raises(RuntimeError) as e:
+        vstree.simplify(mesh, progress=lambda fraction, stage: mesh.close())
+    assert str(e.value) == IN_USE % "vstree.simplify"
+    assert vstree.simplify(mesh).mesh.vertex_count > 0
+
+
+def test_closing_the_mesh_from_another_thread_during_a_call_is_refused(shape):
+    # ctypes releases the GIL during the call: another thread runs meanwhile. The callback
+    # holds the call at its first report while this thread tries to close the mesh.
+    mesh = vstree.Mesh(*shape)
+    inside, release, results = threading.Event(), threading.Event(), []
+
+    def progress(fraction, stage):
+        inside.set()
+        return release.wait(60)
+
+    worker = threading.Thread(target=lambda: results.append(vstree.simplify(mesh, progress=progress)))
+    worker.start()
+    try:
+        assert inside.wait(60)
+        with pytest.raises(RuntimeError) as e:
+            mesh.close()
+        assert str(e.value) == IN_USE % "vstree.simplify"
+    finally:
+        release.set()
+        worker.join(60)
+    assert results[0].mesh.vertex_count > 0
+    mesh.close()
+
+
+def test_closing_a_tree_or_mesh_while_a_call_holds_it_is_refused(shape):
+    # Queries and saves have no callback; what holds them is the same use count.
+    mesh = vstree.Mesh(*shape)
+    tree = vstree.Tree(mesh)
+    for thing, who in [(tree, "Tree.nodes"), (mesh, "Mesh.save")]:
+        with thing._use(who):
+            with pytest.raises(RuntimeError, match="in use by %s, which is still running" % who):
+                thing.close()
+        thing.close()
+        thing.close()
+
+
+def test_threads_reading_a_mesh_while_another_closes_it_see_it_whole_or_closed(shape):
+    for _ in range(20):
+        mesh = vstree.Mesh(*shape)
+        seen, start = [], threading.Barrier(5)
+
+        def read():
+            start.wait()
+            for _ in range(50):
+                try:
+                    seen.append(mesh.positions.shape)
+                except (ValueError, RuntimeError):
+                    pass
+
+        def close():
+            start.wait()
+            while True:
+                try:
+                    return mesh.close()
+                except RuntimeError:  # a reader holds it: try again
+                    pass
+
+        threads = [threading.Thread(target=read) for _ in range(4)] + [threading.Thread(target=close)]
+        for th in threads:
+            th.start()
+        for th in threads:
+            th.join()
+        assert set(seen) <= {shape[0].shape}
+        with pytest.raises(ValueError):
+            mesh.positions
