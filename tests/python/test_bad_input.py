@@ -5,8 +5,10 @@ What the library says is pinned as it is today: a change of wording fails here o
 
 ``{tmp}`` in a message stands for the test's tmp_path."""
 
+import copy
 import os
 import pathlib
+import pickle
 
 import numpy as np
 import pytest
@@ -159,6 +161,47 @@ CLOSED_CASES = [
     case("closed-tree-t-nodes", lambda c: c.closed_tree().t_nodes, ValueError, None, TREE_CLOSED),
     case("closed-tree-levels", lambda c: c.closed_tree().levels, ValueError, None, TREE_CLOSED),
     case("closed-tree-vertex-labels", lambda c: c.closed_tree().vertex_labels("t_node"), ValueError, None, TREE_CLOSED),
+    case("copy-closed-mesh", lambda c: copy.copy(c.closed_mesh()), ValueError, None, MESH_CLOSED),
+    case("pickle-closed-mesh", lambda c: pickle.dumps(c.closed_mesh()), ValueError, None, MESH_CLOSED),
+]
+
+
+# ---- copies of what cannot be copied, and closing what a running call uses --------------------
+
+TREE_NOT_COPIED = (
+    "vstree.Tree cannot be copied or pickled: it owns a tree in the library, which a copy would share and free "
+    "twice, and a pickle would store only its address; build another with vstree.Tree(mesh, **params), or copy "
+    "or pickle its arrays (stats, nodes, t_nodes, levels, vertex_labels()), which are plain Python and numpy "
+    "objects"
+)
+IN_USE = (
+    "Mesh.close: the mesh is in use by %s, which is still running (close() was called from its progress "
+    "callback or from another thread); the library reads it, so it cannot be freed now: close it after the "
+    "call returns"
+)
+
+
+def close_in_callback(call):
+    """``call(mesh, progress)`` with a callback that closes the mesh the call is using."""
+
+    def run(c):
+        mesh = vstree.Mesh(CLOUD, None, CLOUD) if call is not vstree.estimate_normals else vstree.Mesh(CLOUD)
+        return call(mesh, progress=lambda fraction, stage: mesh.close())
+
+    return run
+
+
+IN_USE_CASES = [
+    case("copy-tree", lambda c: copy.copy(vstree.Tree(c.mesh())), TypeError, None, TREE_NOT_COPIED),
+    case("deepcopy-tree", lambda c: copy.deepcopy(vstree.Tree(c.mesh())), TypeError, None, TREE_NOT_COPIED),
+    case("pickle-tree", lambda c: pickle.dumps(vstree.Tree(c.mesh())), TypeError, None, TREE_NOT_COPIED),
+    case("simplify-closes-its-mesh", close_in_callback(vstree.simplify), RuntimeError, None,
+         IN_USE % "vstree.simplify"),
+    case("tree-closes-its-mesh", close_in_callback(vstree.Tree), RuntimeError, None, IN_USE % "vstree.Tree"),
+    case("reconstruct-closes-its-mesh", close_in_callback(vstree.reconstruct), RuntimeError, None,
+         IN_USE % "vstree.reconstruct"),
+    case("estimate-normals-closes-its-mesh", close_in_callback(vstree.estimate_normals), RuntimeError, None,
+         IN_USE % "vstree.estimate_normals"),
 ]
 
 
@@ -650,7 +693,7 @@ FILE_CASES = [
          ("vstree_mesh_save: {tmp}/out.ply: ", "directory"), False),
 ]
 
-CASES = NUL_CASES + CLOSED_CASES + PARAMETER_CASES + ARRAY_CASES + TYPE_CASES + FILE_CASES
+CASES = NUL_CASES + CLOSED_CASES + IN_USE_CASES + PARAMETER_CASES + ARRAY_CASES + TYPE_CASES + FILE_CASES
 
 
 @pytest.mark.parametrize("call, exc, status, message, exact", CASES)
