@@ -274,3 +274,59 @@ fn help_shows_the_library_defaults() {
     assert_eq!(number("reconstruct", "neighbours"), recon.normals.neighbours as f64);
     assert_eq!(vstree::SimplifyParams::default().tree.error, TreeParams::DEFAULT_ERROR);
 }
+
+/// A reader that goes away (`vstree stats … | head -c 10`) ends the report quietly: no message,
+/// and the run ends with its own status, its output file written. A report that cannot be
+/// written (a full disk) is an error naming standard output.
+#[cfg(unix)]
+#[test]
+fn a_closed_or_full_standard_output_never_panics() {
+    use std::process::Stdio;
+    let dir = temp_dir("stdout");
+    let cloud = dir.join("cloud.xyz");
+    let mut points = shapes::sample_surface(&shapes::icosphere(1.0, 3), 3000, 2);
+    points.normals = None; // a report line before the work, about the estimated normals
+    io::write(&cloud, &points).unwrap();
+    let mesh = dir.join("sphere.ply");
+    io::write(&mesh, &shapes::icosphere(1.0, 3)).unwrap();
+    let output = dir.join("out.ply");
+    let closed_pipe = |args: &[&str]| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_vstree"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take()); // the reader is gone before the first line
+        child.wait_with_output().unwrap()
+    };
+    for args in [
+        vec!["stats", cloud.to_str().unwrap(), "--compare"],
+        vec!["simplify", cloud.to_str().unwrap(), output.to_str().unwrap()],
+        vec!["simplify", mesh.to_str().unwrap(), output.to_str().unwrap()],
+    ] {
+        let _ = std::fs::remove_file(&output);
+        let run = closed_pipe(&args);
+        assert_eq!(run.status.code(), Some(0), "{args:?}: {}", String::from_utf8_lossy(&run.stderr));
+        assert_eq!(String::from_utf8_lossy(&run.stderr), "", "{args:?}");
+        assert_eq!(output.exists(), args[0] == "simplify", "{args:?}");
+    }
+    let full = |args: &[&str]| {
+        let dev_full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+        Command::new(env!("CARGO_BIN_EXE_vstree")).args(args).stdout(dev_full).output().unwrap()
+    };
+    for args in [
+        vec!["simplify", mesh.to_str().unwrap(), output.to_str().unwrap()],
+        vec!["stats", cloud.to_str().unwrap()],
+        vec!["--help"],
+    ] {
+        let run = full(&args);
+        assert_eq!(run.status.code(), Some(1), "{args:?}");
+        assert_eq!(
+            String::from_utf8_lossy(&run.stderr),
+            "vstree: error: standard output: No space left on device (os error 28)\n",
+            "{args:?}"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

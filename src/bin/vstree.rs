@@ -11,6 +11,63 @@ use vstree::simplify::{simplify, KeepTopology, SimplifyParams, SimplifyStats};
 use vstree::tree::{Metric, TreeKind, TreeParams, TreeStats};
 use vstree::{io, MeshSampling, Progress, SampleSet, Threads};
 
+/// Prints a line of the report on standard output through [`console::out`]; a failed write
+/// returns its error from the enclosing function.
+macro_rules! say {
+    ($($arg:tt)*) => {
+        console::out(format_args!($($arg)*))?
+    };
+}
+
+/// Prints a line on standard error through [`console::err`].
+macro_rules! warn {
+    ($($arg:tt)*) => {
+        console::err(format_args!($($arg)*))
+    };
+}
+
+/// The CLI's two streams, written without ever panicking (`println!` panics when a write
+/// fails).
+mod console {
+    use std::io::{ErrorKind, Write};
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    /// Set once the reader of standard output has gone.
+    static CLOSED: AtomicBool = AtomicBool::new(false);
+
+    /// Writes a line of the report on standard output. When the reader has gone (a pipe closed
+    /// early, as by `| head`), the rest of the report is dropped quietly and the run goes on:
+    /// its product is the output file, which is still wanted. Any other failure (a full disk)
+    /// is an error naming standard output.
+    pub fn out(line: std::fmt::Arguments) -> vstree::Result<()> {
+        if closed() {
+            return Ok(());
+        }
+        match writeln!(std::io::stdout().lock(), "{line}") {
+            Err(e) if e.kind() == ErrorKind::BrokenPipe => {
+                CLOSED.store(true, Ordering::Relaxed);
+                Ok(())
+            }
+            result => result.map_err(stdout_error),
+        }
+    }
+
+    /// Whether the reader of standard output has gone.
+    pub fn closed() -> bool {
+        CLOSED.load(Ordering::Relaxed)
+    }
+
+    /// A failed write to standard output as the error the user reads.
+    pub fn stdout_error(source: std::io::Error) -> vstree::Error {
+        vstree::Error::Io { path: "standard output".into(), source }
+    }
+
+    /// Writes a line on standard error; a failure is ignored, as there is nowhere left to say it.
+    pub fn err(line: std::fmt::Arguments) {
+        let _ = writeln!(std::io::stderr().lock(), "{line}");
+    }
+}
+
 #[derive(Parser)]
 #[command(
     name = "vstree",
@@ -258,15 +315,31 @@ impl TreeArgs {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return parse_failure(&e),
+    };
     // Ctrl-C or a kill while an output is pending must not leave its hidden temporary file.
     io::remove_temporary_files_on_signals();
     match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("vstree: error: {}", message(&e));
+            warn!("vstree: error: {}", message(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Prints what the argument parser says (help and version on standard output, usage errors on
+/// standard error) and gives its exit code; help or version that cannot be written is an
+/// error, as any report is (a closed pipe is not).
+fn parse_failure(e: &clap::Error) -> ExitCode {
+    match e.print() {
+        Err(failure) if !e.use_stderr() && failure.kind() != std::io::ErrorKind::BrokenPipe => {
+            warn!("vstree: error: {}", console::stdout_error(failure));
+            ExitCode::FAILURE
+        }
+        _ => ExitCode::from(e.exit_code().clamp(0, 255) as u8),
     }
 }
 
@@ -333,7 +406,7 @@ fn read_with_normals(path: &Path, threads: usize, quiet: bool) -> vstree::Result
         let params = vstree::normals::NormalParams { threads, ..Default::default() };
         let report = with_progress(quiet, |p| vstree::normals::ensure_normals(&mut mesh, &params, p))?;
         if !quiet && report.estimated > 0 {
-            println!("normals: {} estimated from {} neighbours", report.estimated, report.neighbours);
+            say!("normals: {} estimated from {} neighbours", report.estimated, report.neighbours);
         }
     }
     Ok(mesh)
@@ -363,7 +436,7 @@ fn run(command: Command) -> vstree::Result<()> {
             let (out, stats) = with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
             let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
-                print_simplify(&input, &output, &stats, read_s, write_s);
+                print_simplify(&input, &output, &stats, read_s, write_s)?;
             }
             say_size_missed(params.target_faces, &stats);
             Ok(())
@@ -410,7 +483,7 @@ fn run(command: Command) -> vstree::Result<()> {
             let (out, stats) = with_progress(tree.quiet, |progress| reconstruct(&cloud, &params, progress))?;
             let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
-                print_reconstruct(&input, &output, cloud.positions.len(), &stats, read_s, write_s);
+                print_reconstruct(&input, &output, cloud.positions.len(), &stats, read_s, write_s)?;
             }
             Ok(())
         }
@@ -431,19 +504,22 @@ fn run(command: Command) -> vstree::Result<()> {
                 let other = if kinds[0].kind == TreeKind::VsTree { TreeKind::Octree } else { TreeKind::VsTree };
                 kinds.push(TreeParams { kind: other, ..kinds[0] });
             }
-            println!("{}: {} samples", input.display(), samples.len());
+            say!("{}: {} samples", input.display(), samples.len());
             let mut leaves = Vec::new();
             for params in kinds {
+                if console::closed() {
+                    return Ok(()); // the statistics are the output, and nobody reads them
+                }
                 let (built, seconds) = timed(|| {
                     with_progress(tree.quiet, |progress| vstree::tree::build(&samples, &params, &threads, progress))
                 })?;
                 let stats = built.stats();
-                println!("{:?}: built in {:.3} s", params.kind, seconds);
-                print_tree(&stats);
+                say!("{:?}: built in {:.3} s", params.kind, seconds);
+                print_tree(&stats)?;
                 leaves.push(stats.leaves);
             }
             if let [first, second] = leaves[..] {
-                println!("clusters: {first} vs {second} ({:+.1}%)", 100.0 * (first as f64 / second as f64 - 1.0));
+                say!("clusters: {first} vs {second} ({:+.1}%)", 100.0 * (first as f64 / second as f64 - 1.0));
             }
             Ok(())
         }
@@ -498,7 +574,7 @@ fn say_size_missed(target: usize, s: &SimplifyStats) {
         } else {
             "the input has no more distinct clusters to give"
         };
-        eprintln!("vstree: warning: {} triangles instead of the {target} asked for: {why}", s.output_triangles);
+        warn!("vstree: warning: {} triangles instead of the {target} asked for: {why}", s.output_triangles);
     }
 }
 
@@ -510,7 +586,7 @@ fn say_threads(requested: usize, quiet: bool) {
     }
     let used = Threads::count_for(requested);
     if !quiet && requested > used {
-        eprintln!("vstree: --threads {requested}: this machine runs {used} at once; using {used}");
+        warn!("vstree: --threads {requested}: this machine runs {used} at once; using {used}");
     }
 }
 
@@ -536,80 +612,91 @@ fn with_progress<T>(quiet: bool, f: impl FnOnce(&mut Progress) -> vstree::Result
     result
 }
 
-fn print_tree(s: &TreeStats) {
-    println!("  nodes: {} (V {}, T {}, S {}), depth {}", s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.max_depth);
+fn print_tree(s: &TreeStats) -> vstree::Result<()> {
+    say!("  nodes: {} (V {}, T {}, S {}), depth {}", s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.max_depth);
     if s.t_nodes > 0 {
-        println!("  T-layer depth: {}..{}", s.t_depth_min, s.t_depth_max);
+        say!("  T-layer depth: {}..{}", s.t_depth_min, s.t_depth_max);
     }
-    println!(
+    say!(
         "  clusters (leaves): {}, samples per cluster: mean {:.1}, variance {:.1}",
-        s.leaves, s.leaf_size_mean, s.leaf_size_variance
+        s.leaves,
+        s.leaf_size_mean,
+        s.leaf_size_variance
     );
+    Ok(())
 }
 
-fn print_simplify(input: &Path, output: &Path, s: &SimplifyStats, read_s: f64, write_s: f64) {
-    println!("{}: {} vertices, {} triangles", input.display(), s.input_vertices, s.input_triangles);
-    println!("samples: {}", s.tree.samples);
-    print_tree(&s.tree);
-    println!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
-    println!("topology: {}", if s.kept_topology { "kept" } else { "not kept (plain clustering)" });
-    println!(
+fn print_simplify(input: &Path, output: &Path, s: &SimplifyStats, read_s: f64, write_s: f64) -> vstree::Result<()> {
+    say!("{}: {} vertices, {} triangles", input.display(), s.input_vertices, s.input_triangles);
+    say!("samples: {}", s.tree.samples);
+    print_tree(&s.tree)?;
+    say!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
+    say!("topology: {}", if s.kept_topology { "kept" } else { "not kept (plain clustering)" });
+    say!(
         "time: read {:.3} s, samples {:.3} s, tree {:.3} s, clustering {:.3} s, write {:.3} s",
-        read_s, s.seconds_samples, s.seconds_tree, s.seconds_cluster, write_s
+        read_s,
+        s.seconds_samples,
+        s.seconds_tree,
+        s.seconds_cluster,
+        write_s
     );
+    Ok(())
 }
 
-fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &ReconstructStats, read_s: f64, write_s: f64) {
-    println!("{}: {} points", input.display(), points);
+fn print_reconstruct(
+    input: &Path,
+    output: &Path,
+    points: usize,
+    s: &ReconstructStats,
+    read_s: f64,
+    write_s: f64,
+) -> vstree::Result<()> {
+    say!("{}: {} points", input.display(), points);
     if s.normals.estimated > 0 {
-        println!("normals: {} estimated from {} neighbours", s.normals.estimated, s.normals.neighbours);
+        say!("normals: {} estimated from {} neighbours", s.normals.estimated, s.normals.neighbours);
     }
     if let Some(o) = &s.normals.orient {
-        println!("orientation: {} components, {} flipped", o.components, o.flipped);
+        say!("orientation: {} components, {} flipped", o.components, o.flipped);
     }
-    print_tree(&s.tree);
+    print_tree(&s.tree)?;
     let genus = s.base_genus.map_or("not a closed manifold".to_string(), |g| format!("genus {g}"));
     let thickened = if s.thickened { " (thickened: the plain one had handles through thin parts)" } else { "" };
-    println!("grid: {} cells across, {} triangles polygonised{thickened}", s.grid_cells, s.fine_triangles);
-    println!("M0: {} vertices, {} triangles, {genus}, error {:.2e}", s.base_vertices, s.base_triangles, s.base_error);
+    say!("grid: {} cells across, {} triangles polygonised{thickened}", s.grid_cells, s.fine_triangles);
+    say!("M0: {} vertices, {} triangles, {genus}, error {:.2e}", s.base_vertices, s.base_triangles, s.base_error);
     for (k, level) in s.levels.iter().enumerate() {
-        println!(
-            "level {}: {} new vertices, {} displaced by the quadtrees",
-            k + 1,
-            level.new_vertices,
-            level.displaced
-        );
+        say!("level {}: {} new vertices, {} displaced by the quadtrees", k + 1, level.new_vertices, level.displaced);
     }
     if s.stopped == RefinementStop::TriangleBudget {
-        eprintln!(
+        warn!(
             "warning: refinement stopped short of the target: another level would exceed the library's triangle budget"
         );
     }
-    println!("refinement stopped: {}", s.stopped.as_str());
-    println!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
+    say!("refinement stopped: {}", s.stopped.as_str());
+    say!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
     let share = 100.0 * s.unsupported_share;
     if s.open {
-        println!("open: {share:.0}% of the closed surface is unsupported by the samples; kept: the part they support (--closed closes it)");
+        say!("open: {share:.0}% of the closed surface is unsupported by the samples; kept: the part they support (--closed closes it)");
     } else {
-        println!(
+        say!(
             "closed: {share:.0}% of the closed surface is unsupported by the samples, closed over (--open keeps it open)"
         );
     }
     if s.final_error > FAR_FROM_SAMPLES {
-        eprintln!(
+        warn!(
             "warning: the surface is far from the samples (RMS {:.1}% of the diagonal) and does not \
              represent this cloud",
             100.0 * s.final_error
         );
     }
     if s.trimmed_triangles > 0 {
-        println!("trimmed: {} triangles far from the samples", s.trimmed_triangles);
+        say!("trimmed: {} triangles far from the samples", s.trimmed_triangles);
     }
-    println!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
-    println!(
+    say!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
+    say!(
         "time: read {:.3} s, normals {:.3} s, tree {:.3} s, base mesh {:.3} s, refinement {:.3} s, trim {:.3} s, write {:.3} s",
         read_s, s.seconds_normals, s.seconds_tree, s.seconds_base, s.seconds_refine, s.seconds_trim, write_s
     );
+    Ok(())
 }
 
 /// The `demo` job: both algorithms on generated shapes whose answers are known.
@@ -623,18 +710,18 @@ fn demo(out: &Path) -> vstree::Result<()> {
         return Err(vstree::Error::Io { path: out.to_path_buf(), source: e });
     }
     std::fs::create_dir_all(out).map_err(|e| vstree::Error::Io { path: out.to_path_buf(), source: e })?;
-    println!("== simplification: a bumpy sphere, VS-Tree against octree at the same L2 bound (1e-5)");
+    say!("== simplification: a bumpy sphere, VS-Tree against octree at the same L2 bound (1e-5)");
     let mesh = shapes::bumpy_sphere(1.0, 0.08, 5.0, 8);
     let input = out.join("demo-sphere.ply");
     io::write(&input, &mesh)?;
-    println!("{}: {} vertices, {} triangles", input.display(), mesh.positions.len(), mesh.triangles.len());
+    say!("{}: {} vertices, {} triangles", input.display(), mesh.positions.len(), mesh.triangles.len());
     for (kind, name) in [(TreeKind::VsTree, "vstree"), (TreeKind::Octree, "octree")] {
         let params =
             SimplifyParams { tree: TreeParams { kind, error: 1e-5, ..TreeParams::default() }, ..Default::default() };
         let (simplified, stats) = with_progress(false, |p| simplify(&mesh, &params, p))?;
         let path = out.join(format!("demo-sphere-{name}.ply"));
         io::write(&path, &simplified)?;
-        println!(
+        say!(
             "{:7} {} clusters -> {}: {} triangles in {:.3} s",
             name,
             stats.tree.leaves,
@@ -644,7 +731,7 @@ fn demo(out: &Path) -> vstree::Result<()> {
         );
     }
 
-    println!("\n== reconstruction: 200k noisy points on a genus-3 pretzel");
+    say!("\n== reconstruction: 200k noisy points on a genus-3 pretzel");
     let mut cloud = shapes::sample_surface(&shapes::genus_n_pretzel(3), 200_000, 1);
     shapes::add_noise(&mut cloud, 0.002, 0.05, 2);
     let input = out.join("demo-pretzel-points.ply");
@@ -652,8 +739,8 @@ fn demo(out: &Path) -> vstree::Result<()> {
     let (mesh, stats) = with_progress(false, |p| reconstruct(&cloud, &ReconstructParams::default(), p))?;
     let output = out.join("demo-pretzel-reconstructed.ply");
     io::write(&output, &mesh)?;
-    print_reconstruct(&input, &output, cloud.positions.len(), &stats, 0.0, 0.0);
+    print_reconstruct(&input, &output, cloud.positions.len(), &stats, 0.0, 0.0)?;
     let report = topology::analyze(&mesh);
-    println!("result: watertight {}, genus {:?} (the shape has genus 3)", report.is_watertight(), report.genus());
+    say!("result: watertight {}, genus {:?} (the shape has genus 3)", report.is_watertight(), report.genus());
     Ok(())
 }
