@@ -174,23 +174,55 @@ fn an_unwritable_output_fails_before_the_work() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// SIGINT, SIGTERM or SIGHUP while a run is under way leave no hidden temporary output behind,
-/// and the process still ends by the signal (so shells see it as interrupted).
-#[cfg(unix)]
+/// Every signal that ends a process and can be caught (Ctrl-C, SIGTERM, SIGHUP, SIGQUIT, the
+/// user, timer and CPU-limit signals, the real-time ones) leaves no hidden temporary output
+/// behind when it arrives during a run, and the process still ends by the signal (so shells
+/// see it as interrupted). A signal the run was started with ignored (`nohup`) stays ignored.
+#[cfg(target_os = "linux")]
 #[test]
 fn an_interrupted_run_leaves_no_temporary_file() {
-    use std::os::unix::process::ExitStatusExt;
+    use std::os::unix::process::{CommandExt, ExitStatusExt};
     use std::time::{Duration, Instant};
     let dir = temp_dir("signals");
     let input = dir.join("cloud.ply");
     // Large enough that reconstruction runs for a while after the output is reserved.
     io::write(&input, &shapes::sample_surface(&shapes::genus_n_pretzel(2), 300_000, 5)).unwrap();
     let output = dir.join("out.ply");
-    for signal in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_vstree"))
-            .args(["reconstruct", input.to_str().unwrap(), output.to_str().unwrap(), "-q"])
-            .spawn()
-            .unwrap();
+    let signals = [
+        libc::SIGINT,
+        libc::SIGTERM,
+        libc::SIGHUP,
+        libc::SIGQUIT,
+        libc::SIGUSR1,
+        libc::SIGUSR2,
+        libc::SIGALRM,
+        libc::SIGVTALRM,
+        libc::SIGPROF,
+        libc::SIGXCPU,
+        libc::SIGIO,
+        libc::SIGPWR,
+        libc::SIGSTKFLT,
+        libc::SIGRTMIN(),
+        libc::SIGRTMAX(),
+    ];
+    // The last run starts with SIGHUP ignored: the SIGHUP it gets is no end, its SIGTERM is.
+    let runs = signals.iter().map(|&s| (s, None)).chain([(libc::SIGTERM, Some(libc::SIGHUP))]);
+    for (signal, ignored) in runs {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_vstree"));
+        command.args(["reconstruct", input.to_str().unwrap(), output.to_str().unwrap(), "-q"]);
+        // SAFETY: only async-signal-safe calls between fork and exec. No core files from the
+        // signals that dump core (SIGQUIT, SIGXCPU).
+        unsafe {
+            command.pre_exec(move || {
+                let none = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+                libc::setrlimit(libc::RLIMIT_CORE, &none);
+                if let Some(ignored) = ignored {
+                    libc::signal(ignored, libc::SIG_IGN);
+                }
+                Ok(())
+            });
+        }
+        let mut child = command.spawn().unwrap();
         let start = Instant::now();
         let temporary = || {
             std::fs::read_dir(&dir)
@@ -201,6 +233,13 @@ fn an_interrupted_run_leaves_no_temporary_file() {
             assert!(start.elapsed() < Duration::from_secs(20), "no temporary output appeared");
             assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be interrupted");
             std::thread::sleep(Duration::from_millis(2));
+        }
+        if let Some(ignored) = ignored {
+            // SAFETY: the child is alive (not yet waited for).
+            unsafe { libc::kill(child.id() as libc::pid_t, ignored) };
+            std::thread::sleep(Duration::from_millis(200));
+            assert!(child.try_wait().unwrap().is_none(), "an ignored signal {ignored} ended the run");
+            assert!(temporary(), "an ignored signal {ignored} removed the temporary output");
         }
         // SAFETY: the child is alive (not yet waited for).
         unsafe { libc::kill(child.id() as libc::pid_t, signal) };
@@ -328,5 +367,42 @@ fn a_closed_or_full_standard_output_never_panics() {
             "{args:?}"
         );
     }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A run stopped by the file-size limit (`ulimit -f`) fails like any other write: a message
+/// naming the output and the cause, exit code 1, no temporary file left and the old output
+/// untouched (instead of dying of SIGXFSZ with the temporary file left behind).
+#[cfg(unix)]
+#[test]
+fn a_file_size_limit_is_a_write_error() {
+    use std::os::unix::process::CommandExt;
+    let dir = temp_dir("fsize");
+    let input = dir.join("sphere.ply");
+    io::write(&input, &shapes::icosphere(1.0, 4)).unwrap();
+    let output = dir.join("out.ply");
+    std::fs::write(&output, "old").unwrap();
+    let mut command = Command::new(env!("CARGO_BIN_EXE_vstree"));
+    // A bound fine enough to keep most of the 2562 vertices: about 90 kB to write.
+    command.args(["simplify", input.to_str().unwrap(), output.to_str().unwrap(), "--error", "1e-9", "-q"]);
+    // SAFETY: setrlimit is async-signal-safe.
+    unsafe {
+        command.pre_exec(|| {
+            let limit = libc::rlimit { rlim_cur: 16 * 1024, rlim_max: 16 * 1024 };
+            libc::setrlimit(libc::RLIMIT_FSIZE, &limit);
+            Ok(())
+        });
+    }
+    let run = command.output().unwrap();
+    assert_eq!(run.status.code(), Some(1), "{:?}", run.status);
+    assert_eq!(
+        String::from_utf8_lossy(&run.stderr),
+        format!("vstree: error: {}: File too large (os error 27)\n", output.display())
+    );
+    assert_eq!(std::fs::read_to_string(&output).unwrap(), "old");
+    let mut names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, vec!["out.ply", "sphere.ply"]);
     std::fs::remove_dir_all(dir).unwrap();
 }
