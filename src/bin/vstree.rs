@@ -104,11 +104,11 @@ enum Command {
         /// this count (within one triangle). Below what the topology allows (a closed surface
         /// of genus g needs more than 4 g triangles, a tetrahedron's 4 at least) the output is
         /// the smallest mesh reachable, and a warning says so. 0 = use the error bound.
-        #[arg(long, allow_negative_numbers = true, conflicts_with_all = ["ratio", "error"])]
+        #[arg(long, allow_hyphen_values = true, conflicts_with_all = ["ratio", "error"])]
         faces: Option<i64>,
         /// Fraction of the input's triangles wanted, in (0, 1] (instead of --error): 0.1 keeps
         /// 10%, rounded, at least 1 triangle; then as --faces.
-        #[arg(long, allow_negative_numbers = true, conflicts_with = "error")]
+        #[arg(long, allow_hyphen_values = true, conflicts_with = "error")]
         ratio: Option<f64>,
         /// Keep the topology: clusters merge by edge collapses that keep a closed 2-manifold
         /// closed and manifold with its genus (and an open one's borders manifold); a cluster
@@ -139,15 +139,15 @@ enum Command {
         tree: TreeArgs,
         /// Stop refining once the RMS distance from the samples to the mesh is at most this
         /// fraction of the bounding-box diagonal (0 = refine while the tree has detail left).
-        #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().target_distance)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().target_distance)]
         target: f64,
         /// Most refinement levels (each one multiplies the triangles by 4).
-        #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().max_levels)]
-        levels: u32,
+        #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().max_levels.into())]
+        levels: i64,
         /// Remove every face farther than this many grid cells from every sample, and make the
         /// output open (0 = no such trimming: open scans are found and cut at their border
         /// without it).
-        #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().trim)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().trim)]
         trim: f32,
         /// Keep only the part of the surface that the samples support, whatever its share: a
         /// scan's holes stay open too. By default the output is open only where much of the
@@ -169,8 +169,8 @@ enum Command {
         #[arg(long)]
         reorient: bool,
         /// Neighbours used to estimate normals (3-256).
-        #[arg(long, allow_negative_numbers = true, default_value_t = vstree::normals::DEFAULT_NEIGHBOURS)]
-        neighbours: usize,
+        #[arg(long, allow_hyphen_values = true, default_value_t = vstree::normals::DEFAULT_NEIGHBOURS as i64)]
+        neighbours: i64,
         /// Write PLY as text instead of binary.
         #[arg(long)]
         ascii: bool,
@@ -222,27 +222,27 @@ struct TreeArgs {
     /// samples per cluster.
     /// Larger = coarser output (and, to reconstruct, smoother: it is the de-noising control).
     /// [default: 1e-3 to simplify and for stats, 1e-5 to reconstruct]
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true)]
     error: Option<f64>,
     /// Normal-cone threshold of the height-field test, in [0, 1]: a cell becomes a surface
     /// (2D) node only if every normal's dot product with the mean normal exceeds it. Raise it
     /// for more adaptivity in curved areas.
-    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().d_a)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().d_a)]
     da: f32,
     /// Displacement threshold of the height-field test, in [0, 1]: a cell's height range over
     /// its radius must stay below it. Lower it for more adaptivity in curved areas.
-    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().d_d)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().d_d)]
     dd: f32,
     /// Deepest tree level (1-30).
-    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().max_depth)]
-    max_depth: u32,
+    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().max_depth.into())]
+    max_depth: i64,
     /// Cells smaller than this fraction of the bounding-box diagonal are not split, in [0, 1):
     /// guards against duplicate points.
-    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().min_cell_size)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().min_cell_size)]
     min_cell_size: f64,
     /// Worker threads (0 = all cores).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
-    threads: usize,
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
+    threads: i64,
     /// No progress bar and no report: print nothing but errors (`stats` still prints its
     /// statistics, which are its output).
     #[arg(long, short)]
@@ -294,24 +294,39 @@ impl From<Sampling> for MeshSampling {
 }
 
 impl TreeArgs {
-    fn params(&self, default_error: f64) -> TreeParams {
-        TreeParams {
+    fn params(&self, default_error: f64) -> vstree::Result<TreeParams> {
+        let metric = match self.metric {
+            MetricArg::L2 => Metric::L2,
+            MetricArg::L21 => Metric::L21,
+            MetricArg::Density => Metric::Density,
+        };
+        Ok(TreeParams {
             kind: match self.tree {
                 Kind::Vstree => TreeKind::VsTree,
                 Kind::Octree => TreeKind::Octree,
             },
-            metric: match self.metric {
-                MetricArg::L2 => Metric::L2,
-                MetricArg::L21 => Metric::L21,
-                MetricArg::Density => Metric::Density,
-            },
+            metric,
             error: self.error.unwrap_or(default_error),
             d_a: self.da,
             d_d: self.dd,
-            max_depth: self.max_depth,
+            max_depth: unsigned("max_depth", self.max_depth, format_args!("from 1 to {}", vstree::tree::MAX_DEPTH))?,
             min_cell_size: self.min_cell_size,
-        }
+        })
     }
+
+    /// `--threads`, checked for sign (the library checks the rest).
+    fn threads(&self) -> vstree::Result<usize> {
+        unsigned("threads", self.threads, format_args!("from 0 (all cores) to {}", Threads::MAX))
+    }
+}
+
+/// An integer flag's value in the library's unsigned type. The flags are read as signed
+/// numbers so that a negative value is not taken for a flag; it never reaches the library's
+/// range check (nor does one too large for the type), so it is refused here with the flag's
+/// `range`, in the library's words.
+fn unsigned<T: TryFrom<i64>>(name: &'static str, value: i64, range: std::fmt::Arguments) -> vstree::Result<T> {
+    T::try_from(value)
+        .map_err(|_| vstree::Error::InvalidParameter { name, message: format!("{value}: must be {range}") })
 }
 
 fn main() -> ExitCode {
@@ -415,12 +430,13 @@ fn read_with_normals(path: &Path, threads: usize, quiet: bool) -> vstree::Result
 fn run(command: Command) -> vstree::Result<()> {
     match command {
         Command::Simplify { input, output, tree, sampling, faces, ratio, keep_topology, no_keep_topology, ascii } => {
-            let tree_params = tree.params(SIMPLIFY_ERROR);
+            let tree_params = tree.params(SIMPLIFY_ERROR)?;
             tree_params.check()?; // before reading what may be a large file
+            let threads = tree.threads()?;
             let size = Size::from_flags(faces, ratio)?;
             let target = reserve_output(&input, &output)?;
-            say_threads(tree.threads, tree.quiet);
-            let (mesh, read_s) = timed(|| read_with_normals(&input, tree.threads, tree.quiet))?;
+            say_threads(threads, tree.quiet);
+            let (mesh, read_s) = timed(|| read_with_normals(&input, threads, tree.quiet))?;
             let keep_topology = match (keep_topology, no_keep_topology) {
                 (true, _) => KeepTopology::On,
                 (_, true) => KeepTopology::Off,
@@ -429,9 +445,9 @@ fn run(command: Command) -> vstree::Result<()> {
             let params = SimplifyParams {
                 tree: tree_params,
                 sampling: sampling.into(),
-                threads: tree.threads,
+                threads,
                 keep_topology,
-                target_faces: size.faces(mesh.triangles.len()),
+                target_faces: size.faces(mesh.triangles.len())?,
             };
             let (out, stats) = with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
             let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
@@ -456,12 +472,19 @@ fn run(command: Command) -> vstree::Result<()> {
             neighbours,
             ascii,
         } => {
+            let neighbours = unsigned(
+                "neighbours",
+                neighbours,
+                format_args!("from {} to {}", vstree::normals::MIN_NEIGHBOURS, vstree::normals::MAX_NEIGHBOURS),
+            )?;
             let normals = vstree::normals::NormalParams { neighbours, reorient_given: reorient, ..Default::default() };
+            let threads = tree.threads()?;
             let params = ReconstructParams {
                 normals,
-                tree: tree.params(ReconstructParams::default().tree.error),
+                tree: tree.params(ReconstructParams::default().tree.error)?,
                 target_distance: target,
-                max_levels: levels,
+                // The range ReconstructParams::check words.
+                max_levels: unsigned("max_levels", levels, format_args!("from 0 to 12"))?,
                 trim,
                 closure: match (open, closed) {
                     (true, _) => Closure::Open,
@@ -472,12 +495,12 @@ fn run(command: Command) -> vstree::Result<()> {
                     BaseMeshArg::Winding => BaseMesh::Winding,
                     BaseMeshArg::Paper => BaseMesh::Paper,
                 },
-                threads: tree.threads,
+                threads,
                 ..ReconstructParams::default()
             };
             params.check()?;
             let target = reserve_output(&input, &output)?;
-            say_threads(tree.threads, tree.quiet);
+            say_threads(threads, tree.quiet);
             let (mut cloud, read_s) = timed(|| io::read(&input))?;
             cloud.triangles.clear();
             let (out, stats) = with_progress(tree.quiet, |progress| reconstruct(&cloud, &params, progress))?;
@@ -489,16 +512,17 @@ fn run(command: Command) -> vstree::Result<()> {
         }
         Command::Demo { out } => demo(&out),
         Command::Stats { input, tree, sampling, compare } => {
-            let tree_params = tree.params(SIMPLIFY_ERROR);
+            let tree_params = tree.params(SIMPLIFY_ERROR)?;
             tree_params.check()?;
-            say_threads(tree.threads, tree.quiet);
-            let mesh = read_with_normals(&input, tree.threads, tree.quiet)?;
+            let threads = tree.threads()?;
+            say_threads(threads, tree.quiet);
+            let mesh = read_with_normals(&input, threads, tree.quiet)?;
             let samples = if mesh.is_point_cloud() {
                 SampleSet::from_cloud(&mesh)?
             } else {
                 SampleSet::from_mesh(&mesh, sampling.into())?
             };
-            let threads = Threads::new(tree.threads)?;
+            let threads = Threads::new(threads)?;
             let mut kinds = vec![tree_params];
             if compare {
                 let other = if kinds[0].kind == TreeKind::VsTree { TreeKind::Octree } else { TreeKind::VsTree };
@@ -552,13 +576,22 @@ impl Size {
         }
     }
 
-    /// The `target_faces` for an input of `triangles` triangles.
-    fn faces(&self, triangles: usize) -> usize {
-        match *self {
+    /// The `target_faces` for an input of `triangles` triangles; a ratio of a point cloud's
+    /// (none) is refused, naming `--ratio` (a count is refused by the library).
+    fn faces(&self, triangles: usize) -> vstree::Result<usize> {
+        Ok(match *self {
             Size::Bound => 0,
             Size::Faces(n) => n,
+            Size::Ratio(r) if triangles == 0 => {
+                return Err(vstree::Error::InvalidParameter {
+                    name: "ratio",
+                    message: format!(
+                        "{r}: the input is a point cloud, with no triangles to take a fraction of: a ratio needs a mesh (use --error)"
+                    ),
+                })
+            }
             Size::Ratio(r) => ((r * triangles as f64).round() as usize).max(1),
-        }
+        })
     }
 }
 
