@@ -283,7 +283,7 @@ fn a_surface_far_from_its_samples_is_reported() {
 #[test]
 fn help_shows_the_library_defaults() {
     use vstree::reconstruct::ReconstructParams;
-    use vstree::tree::TreeParams;
+    use vstree::tree::{Metric, TreeParams};
     let default_of = |command: &str, flag: &str| -> String {
         let help = String::from_utf8(vstree(&[command, "--help"]).stdout).unwrap();
         let at = help.find(&format!("--{flag} <")).unwrap_or_else(|| panic!("{command} --help lacks --{flag}"));
@@ -304,7 +304,13 @@ fn help_shows_the_library_defaults() {
         let error = default_of(command, "error");
         assert_eq!(
             error,
-            format!("{:e} to simplify and for stats, {:e} to reconstruct", TreeParams::DEFAULT_ERROR, recon.tree.error)
+            format!(
+                "{:e} to simplify and for stats, {:e} to reconstruct; l21: {:e}; density: {}",
+                TreeParams::DEFAULT_ERROR,
+                recon.tree.error,
+                Metric::L21.default_error(),
+                Metric::Density.default_error()
+            )
         );
     }
     assert_eq!(number("reconstruct", "target"), recon.target_distance);

@@ -89,6 +89,12 @@ enum Command {
     /// cloud without normals gets them estimated first. The size is set by the error bound
     /// (--error), or exactly by --faces or --ratio. A closed 2-manifold input keeps its
     /// topology unless --no-keep-topology is given.
+    ///
+    /// A run that would keep nothing of the shape is an error naming the flag that made the tree
+    /// that coarse (--error, --max-depth or --min-cell-size): a mesh whose every triangle
+    /// collapses, or a cloud whose every point collapses into one. A flat cloud (3 points are
+    /// one) is within any L2 or l21 bound of one plane: simplify it with --metric density,
+    /// which splits by sample count (--error 1 keeps every point).
     Simplify {
         /// Input file: .ply, .obj, .off, .xyz or .pwn.
         input: PathBuf,
@@ -221,7 +227,8 @@ struct TreeArgs {
     /// diagonal of its cluster's point); l21: mean squared normal deviation (0-4); density:
     /// samples per cluster.
     /// Larger = coarser output (and, to reconstruct, smoother: it is the de-noising control).
-    /// [default: 1e-3 to simplify and for stats, 1e-5 to reconstruct]
+    /// Given a size (--faces, --ratio), the bound is no bound and is not used.
+    /// [default: 1e-3 to simplify and for stats, 1e-5 to reconstruct; l21: 1e-3; density: 16]
     #[arg(long, allow_hyphen_values = true)]
     error: Option<f64>,
     /// Normal-cone threshold of the height-field test, in [0, 1]: a cell becomes a surface
@@ -294,12 +301,15 @@ impl From<Sampling> for MeshSampling {
 }
 
 impl TreeArgs {
-    fn params(&self, default_error: f64) -> vstree::Result<TreeParams> {
+    /// The tree's parameters; without `--error`, the L2 metric's bound is `l2_error` (the
+    /// command's) and the other metrics' their own, in their units.
+    fn params(&self, l2_error: f64) -> vstree::Result<TreeParams> {
         let metric = match self.metric {
             MetricArg::L2 => Metric::L2,
             MetricArg::L21 => Metric::L21,
             MetricArg::Density => Metric::Density,
         };
+        let default_error = if metric == Metric::L2 { l2_error } else { metric.default_error() };
         Ok(TreeParams {
             kind: match self.tree {
                 Kind::Vstree => TreeKind::VsTree,
