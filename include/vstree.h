@@ -447,7 +447,9 @@ typedef struct vstree_simplify_params {
   /**
    * Split threshold per cluster, read according to `metric`: L2, relative to the squared
    * bounding-box diagonal, finite and > 0 (default 1e-3; larger = coarser); L2,1, unitless,
-   * > 0 (useful range 1e-3 to 4); density, a sample count >= 1.
+   * in (0, 4] (default 1e-3); density, a sample count >= 1 (default 16: the default 1e-3
+   * left in place reads as 16 under density, where it means nothing). Ignored, and not
+   * checked, when `target_faces` is set.
    */
   double error;
   /**
@@ -1339,7 +1341,11 @@ struct vstree_simplify_params vstree_simplify_params_default(void);
  * Simplifies `mesh` (a triangle mesh, or a point cloud with normals) by clustering its
  * samples in the tree `params` describes (NULL: defaults): every cluster becomes one vertex,
  * triangles are re-indexed to them, and those that collapse or repeat are dropped. A point
- * cloud gives one point with a normal per cluster.
+ * cloud gives one point with a normal per cluster. A result that keeps nothing of the shape
+ * fails with VSTREE_STATUS_INVALID_PARAMETER naming the parameter that made the tree that
+ * coarse (`error`, `max_depth` or `min_cell_size`): a mesh whose every triangle collapses, or a
+ * cloud whose every point collapses into one (a flat cloud, 3 points among them, is within any
+ * L2 or L2,1 bound of one plane: the density metric splits it).
  *
  * `progress` (may be NULL) is called with `user_data` from the calling thread as the work
  * goes; returning 0 from it cancels. On success the new result is written to `*out_result`

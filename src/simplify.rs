@@ -11,7 +11,7 @@ use crate::progress::{Progress, Threads};
 use crate::quadric::CellStats;
 use crate::samples::{MeshSampling, SampleSet};
 use crate::topology::analyze;
-use crate::tree::{self, NodeKind, TreeParams, TreeStats, VsTree};
+use crate::tree::{self, Metric, NodeKind, TreeParams, TreeStats, VsTree};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -43,9 +43,9 @@ pub struct SimplifyParams {
     /// Whether the topology is kept; by default when the input is a closed 2-manifold.
     pub keep_topology: KeepTopology,
     /// Triangles wanted, from 1 to the input's count; 0 = as many as the error bound gives.
-    /// With a target, `tree.error` is no bound: the tree (built at that bound, which only sets
-    /// where the work starts) is grown or cut by splitting the cluster with the largest error
-    /// first until there are about half as many clusters as triangles wanted (with the topology
+    /// With a target, `tree.error` is ignored (not even checked): the tree, built at a coarse
+    /// bound of its metric ([`SimplifyParams::check`]), is grown or cut by splitting the cluster
+    /// with the largest error first until there are about half as many clusters as triangles wanted (with the topology
     /// kept, 4 times that: twice as many), and quadric edge collapses under the same topology
     /// rules bring the count to the target (within one triangle: a collapse removes two). A
     /// target below what the topology allows (a closed surface of genus g needs more triangles
@@ -53,6 +53,18 @@ pub struct SimplifyParams {
     /// which [`SimplifyStats::output_triangles`] shows.
     /// Meshes only: a point cloud with a target is refused.
     pub target_faces: usize,
+}
+
+impl SimplifyParams {
+    /// Rejects out-of-range parameters, naming them. With a target size the bound is not used,
+    /// so it is not checked: the tree starts from its metric's seed bound instead.
+    pub fn check(&self) -> Result<()> {
+        if self.target_faces > 0 {
+            seed_tree(&self.tree).check()
+        } else {
+            self.tree.check()
+        }
+    }
 }
 
 /// What [`simplify`] did.
@@ -182,6 +194,7 @@ pub fn cluster_mesh(
 /// simplified mesh and what was done.
 pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> Result<(Mesh, SimplifyStats)> {
     let threads = Threads::new(params.threads)?;
+    params.check()?;
     check_target(mesh, params.target_faces)?;
     let keep = !mesh.is_point_cloud()
         && match params.keep_topology {
@@ -211,17 +224,11 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
     };
     out.origin = mesh.origin;
     if !mesh.triangles.is_empty() && out.triangles.is_empty() {
-        return Err(Error::param(
-            "error",
-            format!(
-                "{}: every triangle collapsed ({} cluster{} for the whole model): the model is within \
-                 this bound of too few planes; use a smaller bound (a flat model, within any bound of one \
-                 plane, needs the density metric)",
-                shown(params.tree.error),
-                stats.leaves,
-                if stats.leaves == 1 { "" } else { "s" }
-            ),
-        ));
+        return Err(collapsed(&tree, "every triangle collapsed"));
+    }
+    // A cloud of one point is what was asked only when all its points are at one place.
+    if mesh.is_point_cloud() && stats.leaves == 1 && samples.len() > 1 && tree.diagonal > 0.0 {
+        return Err(collapsed(&tree, &format!("all {} points collapsed into one", samples.len())));
     }
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
@@ -236,6 +243,52 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
         kept_topology: keep,
     };
     Ok((out, stats))
+}
+
+/// The error of a simplification that kept nothing of the model's shape (`what` happened): it
+/// names the parameter that made the tree this coarse (the depth or cell-size limit where a
+/// leaf beyond the bound could not be split, else the bound) and what to change.
+fn collapsed(tree: &VsTree, what: &str) -> Error {
+    let p = &tree.params;
+    let defaults = TreeParams::default();
+    let leaves = tree.stats().leaves;
+    let what = format!("{what} ({leaves} cluster{} for the whole model)", if leaves == 1 { "" } else { "s" });
+    match tree.limited_by() {
+        Some("max_depth") => Error::param(
+            "max_depth",
+            format!(
+                "{}: {what}: the tree stopped at this depth, coarser than the bound asks; allow a deeper tree (default {})",
+                p.max_depth, defaults.max_depth
+            ),
+        ),
+        Some(name) => Error::param(
+            name,
+            format!(
+                "{}: {what}: cells this small (relative to the diagonal) are not split, so the tree is coarser than \
+                 the bound asks; use a smaller size (default {})",
+                shown(p.min_cell_size),
+                shown(defaults.min_cell_size)
+            ),
+        ),
+        None => {
+            let advice = match p.metric {
+                Metric::L2 => {
+                    "the model is within this bound of too few planes; use a smaller bound (a flat model, within \
+                     any bound of one plane, needs the density metric)"
+                }
+                Metric::L21 => {
+                    "the model's normals vary within this bound over too few cells; use a smaller bound (a flat \
+                     model, whose normals do not vary, needs the density metric)"
+                }
+                Metric::Density => "the model has too few samples for clusters this large; use a smaller count (at least 1)",
+            };
+            let bound = match p.metric {
+                Metric::Density => format!("{} samples per cell", shown(p.error)),
+                _ => shown(p.error),
+            };
+            Error::param("error", format!("{bound}: {what}: {advice}"))
+        }
+    }
 }
 
 /// Refuses a target the input cannot give: more triangles than it has, or any on a cloud.
@@ -272,6 +325,17 @@ const CLUSTER_MARGIN: f64 = 1.05;
 /// need no cut of a deep tree; any start gives the same result up to ties between equal errors
 /// (tree::fit's tests).
 const SEED_ERROR: f64 = 1e-2;
+
+/// The tree a sized run builds before growing or cutting it to the target: `tree` with its
+/// metric's seed bound in place of the bound, which a size ignores. Where it starts matters
+/// only for ties.
+fn seed_tree(tree: &TreeParams) -> TreeParams {
+    let error = match tree.metric {
+        Metric::L2 => SEED_ERROR,
+        metric => metric.default_error(),
+    };
+    TreeParams { error, ..*tree }
+}
 
 /// Clusters per output vertex in a sized run that keeps the topology (unitless): the tree is cut into this many times
 /// the clusters the target needs and quadric edge collapses remove the rest, choosing the
@@ -313,12 +377,7 @@ fn simplify_to_size(
     let t0 = Instant::now();
     let samples = SampleSet::from_mesh(mesh, params.sampling)?;
     let t1 = Instant::now();
-    // The tree is grown or cut from here; where it starts matters only for ties.
-    let seed = match params.tree.metric {
-        tree::Metric::L2 => TreeParams { error: params.tree.error.max(SEED_ERROR), ..params.tree },
-        _ => params.tree,
-    };
-    let mut tree = tree::build(&samples, &seed, threads, &mut progress.stage(0.0, 0.6))?;
+    let mut tree = tree::build(&samples, &seed_tree(&params.tree), threads, &mut progress.stage(0.0, 0.6))?;
     let t2 = Instant::now();
     progress.report(0.6, "fitting the tree to the size")?;
     let mut want = clusters_for(target, None, factor);
@@ -521,19 +580,23 @@ mod tests {
     }
 
     #[test]
-    fn a_sized_run_does_not_depend_on_the_bound_it_starts_from() {
-        // The seed only sets where the tree's growth starts: below it (1e-1, coarser) the seed
-        // is SEED_ERROR, above it (1e-5) the finer tree is cut; the output is the same.
+    fn a_sized_run_does_not_depend_on_the_bound() {
+        // A size ignores the bound: any bound, even one out of range, gives the same output,
+        // with every metric (the tree starts from the metric's seed).
         assert_eq!(SEED_ERROR, 1e-2);
         let mesh = crate::eval::shapes::torus(1.0, 0.3, 96, 48);
-        let run = |error| {
-            let tree = TreeParams { error, ..TreeParams::default() };
-            let params = SimplifyParams { tree, target_faces: 600, ..Default::default() };
-            simplify(&mesh, &params, &mut Progress::none()).unwrap().0
-        };
-        let (coarse, fine) = (run(1e-1), run(1e-5));
-        assert_eq!(coarse, fine);
-        assert!(coarse.triangles.len().abs_diff(600) <= 2);
+        for metric in [Metric::L2, Metric::L21, Metric::Density] {
+            let run = |error| {
+                let tree = TreeParams { metric, error, ..TreeParams::default() };
+                let params = SimplifyParams { tree, target_faces: 600, ..Default::default() };
+                simplify(&mesh, &params, &mut Progress::none()).unwrap().0
+            };
+            let out = run(1e-1);
+            for error in [1e-5, 0.5, 0.0, -1.0, f64::NAN] {
+                assert_eq!(run(error), out, "{metric:?} at {error}");
+            }
+            assert!(out.triangles.len().abs_diff(600) <= 2);
+        }
     }
 
     #[test]

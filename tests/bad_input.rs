@@ -29,11 +29,17 @@ fn empty_inputs_are_refused() {
 
 #[test]
 fn one_two_three_samples_give_trivial_results() {
-    for n in 1..=3 {
+    // One point is kept; two or three distinct ones, within any L2 bound of one plane, would
+    // collapse into one: an error naming the bound (see a_cloud_collapsed_into_one_point_...).
+    let (out, stats) = simplify_default(&cloud(&[Vec3::ONE])).unwrap();
+    assert_eq!((out.positions, stats.tree.samples), (vec![Vec3::ONE], 1));
+    for n in 2..=3 {
         let points: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect();
-        let (out, stats) = simplify_default(&cloud(&points)).unwrap();
-        assert!(!out.positions.is_empty() && out.positions.len() <= n);
-        assert_eq!(stats.tree.samples, n);
+        let m = message(simplify_default(&cloud(&points)));
+        assert!(m.contains(&format!("all {n} points collapsed into one")), "{m}");
+        let each = TreeParams { metric: Metric::Density, error: 1.0, ..Default::default() };
+        let (out, stats) = simplify_with(&cloud(&points), each).unwrap();
+        assert_eq!((out.positions.len(), stats.tree.samples), (n, n));
     }
     let triangle = Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], None, vec![[0, 1, 2]]);
     // Flat: one cluster, no triangle left, which is an error rather than an empty mesh.
@@ -43,10 +49,9 @@ fn one_two_three_samples_give_trivial_results() {
 
 #[test]
 fn coplanar_and_identical_points_work() {
+    // A plane is one cluster under any L2 bound: refused (a_cloud_collapsed_into_one_point_...).
     let plane: Vec<Vec3> = (0..400).map(|i| Vec3::new((i % 20) as f32, (i / 20) as f32, 0.0)).collect();
-    let (out, stats) = simplify_default(&cloud(&plane)).unwrap();
-    assert_eq!(stats.tree.leaves, 1, "a plane is one cluster");
-    assert_eq!(out.positions.len(), 1);
+    assert!(message(simplify_default(&cloud(&plane))).contains("all 400 points collapsed into one"));
     let same = cloud(&[Vec3::splat(3.0); 50]);
     let (out, _) = simplify_default(&same).unwrap();
     assert_eq!(out.positions, vec![Vec3::splat(3.0)]);
@@ -87,11 +92,13 @@ fn huge_and_tiny_coordinates() {
 
 #[test]
 fn normals_that_cancel_out_give_a_cluster_a_unit_normal() {
-    // Two sheets facing away from each other in one cluster: the mean normal is zero.
-    let mut c = cloud(&[Vec3::ZERO, Vec3::X]);
-    c.normals = Some(vec![Vec3::Z, -Vec3::Z]);
-    let (out, stats) = simplify_with(&c, TreeParams { error: 10.0, ..TreeParams::default() }).unwrap();
-    assert_eq!(stats.tree.leaves, 1);
+    // Two sheets facing away from each other in each of two clusters (of at most 2 samples):
+    // the mean normal is zero.
+    let mut c = cloud(&[Vec3::ZERO, Vec3::X, Vec3::X * 10.0, Vec3::X * 11.0]);
+    c.normals = Some(vec![Vec3::Z, -Vec3::Z, Vec3::Z, -Vec3::Z]);
+    let pairs = TreeParams { metric: Metric::Density, error: 2.0, ..TreeParams::default() };
+    let (out, stats) = simplify_with(&c, pairs).unwrap();
+    assert_eq!(stats.tree.leaves, 2);
     let n = out.normals.unwrap()[0];
     assert!((n.length() - 1.0).abs() < 1e-6 && n.z.abs() > 0.999, "{n}");
 }
@@ -187,4 +194,75 @@ fn targets_the_input_cannot_give_are_refused_or_give_the_nearest_mesh() {
     }
     // 0 is the error bound, as without a target.
     assert_eq!(with(&sphere, 0).unwrap().0, simplify_default(&sphere).unwrap().0);
+}
+
+/// A cloud simplified into a single point (all its points within the bound of one plane: a
+/// flat or 3-point cloud is within any L2 bound) is refused as a mesh whose every triangle
+/// collapses is, naming the bound and what splits it; points at one place give that place.
+#[test]
+fn a_cloud_collapsed_into_one_point_is_refused() {
+    let flat: Vec<Vec3> = (0..900).map(|i| Vec3::new((i % 30) as f32, (i / 30) as f32, 0.0)).collect();
+    let e = simplify_default(&cloud(&flat)).unwrap_err();
+    assert!(matches!(e, Error::InvalidParameter { name: "error", .. }), "{e:?}");
+    assert_eq!(
+        e.to_string(),
+        "parameter `error`: 0.001: all 900 points collapsed into one (1 cluster for the whole model): the \
+         model is within this bound of too few planes; use a smaller bound (a flat model, within any bound of one \
+         plane, needs the density metric)"
+    );
+    // The density metric at its default bound splits it.
+    let density = TreeParams { metric: Metric::Density, error: Metric::Density.default_error(), ..Default::default() };
+    let (out, _) = simplify_with(&cloud(&flat), density).unwrap();
+    assert!(out.positions.len() > 900 / 16, "{}", out.positions.len());
+    let (out, _) = simplify_default(&cloud(&[Vec3::splat(0.5); 50])).unwrap();
+    assert_eq!(out.positions, vec![Vec3::splat(0.5)]);
+}
+
+/// A tree made coarse by its depth or cell-size limit, not by its bound, names the limit.
+#[test]
+fn a_collapse_names_the_limit_that_caused_it() {
+    // Two small spheres in opposite corners: each within one octant of the root.
+    let mut mesh = vstree::eval::shapes::icosphere(0.1, 2);
+    let n = mesh.positions.len() as u32;
+    let other: Vec<Vec3> = mesh.positions.iter().map(|p| *p + Vec3::splat(10.0)).collect();
+    let triangles: Vec<[u32; 3]> = mesh.triangles.iter().map(|t| t.map(|v| v + n)).collect();
+    mesh.positions.extend(other);
+    mesh.triangles.extend(triangles);
+    mesh.normals = None;
+    let plain = |tree| SimplifyParams { tree, keep_topology: vstree::KeepTopology::Off, ..Default::default() };
+    for (tree, name, start) in [
+        (TreeParams { max_depth: 1, ..Default::default() }, "max_depth", "1: every triangle collapsed (2 clusters"),
+        (
+            TreeParams { min_cell_size: 0.99, ..Default::default() },
+            "min_cell_size",
+            "0.99: every triangle collapsed (1 cluster",
+        ),
+        (TreeParams { error: 100.0, ..Default::default() }, "error", "100: every triangle collapsed (1 cluster"),
+    ] {
+        match simplify(&mesh, &plain(tree), &mut Progress::none()) {
+            Err(Error::InvalidParameter { name: got, message }) => {
+                assert_eq!(got, name, "{message}");
+                assert!(message.starts_with(start), "{message}");
+            }
+            other => panic!("{tree:?}: {other:?}"),
+        }
+    }
+}
+
+/// Each metric's default bound is one it accepts, and a target size ignores the bound.
+#[test]
+fn every_metric_has_a_valid_default_and_a_size_ignores_the_bound() {
+    let sphere = vstree::eval::shapes::icosphere(1.0, 3);
+    for metric in [Metric::L2, Metric::L21, Metric::Density] {
+        let tree = TreeParams { metric, error: metric.default_error(), ..Default::default() };
+        tree.check().unwrap();
+        let (out, _) = simplify_with(&sphere, tree).unwrap();
+        assert!(!out.triangles.is_empty() && out.triangles.len() <= 1280, "{metric:?}");
+        let bad = TreeParams { metric, error: -1.0, ..Default::default() };
+        let sized = SimplifyParams { tree: bad, target_faces: 500, ..Default::default() };
+        sized.check().unwrap();
+        let (out, _) = simplify(&sphere, &sized, &mut Progress::none()).unwrap();
+        assert!(out.triangles.len().abs_diff(500) <= 5, "{metric:?}: {}", out.triangles.len());
+    }
+    assert_eq!(Metric::Density.default_error(), 16.0);
 }

@@ -174,23 +174,55 @@ fn an_unwritable_output_fails_before_the_work() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// SIGINT, SIGTERM or SIGHUP while a run is under way leave no hidden temporary output behind,
-/// and the process still ends by the signal (so shells see it as interrupted).
-#[cfg(unix)]
+/// Every signal that ends a process and can be caught (Ctrl-C, SIGTERM, SIGHUP, SIGQUIT, the
+/// user, timer and CPU-limit signals, the real-time ones) leaves no hidden temporary output
+/// behind when it arrives during a run, and the process still ends by the signal (so shells
+/// see it as interrupted). A signal the run was started with ignored (`nohup`) stays ignored.
+#[cfg(target_os = "linux")]
 #[test]
 fn an_interrupted_run_leaves_no_temporary_file() {
-    use std::os::unix::process::ExitStatusExt;
+    use std::os::unix::process::{CommandExt, ExitStatusExt};
     use std::time::{Duration, Instant};
     let dir = temp_dir("signals");
     let input = dir.join("cloud.ply");
     // Large enough that reconstruction runs for a while after the output is reserved.
     io::write(&input, &shapes::sample_surface(&shapes::genus_n_pretzel(2), 300_000, 5)).unwrap();
     let output = dir.join("out.ply");
-    for signal in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_vstree"))
-            .args(["reconstruct", input.to_str().unwrap(), output.to_str().unwrap(), "-q"])
-            .spawn()
-            .unwrap();
+    let signals = [
+        libc::SIGINT,
+        libc::SIGTERM,
+        libc::SIGHUP,
+        libc::SIGQUIT,
+        libc::SIGUSR1,
+        libc::SIGUSR2,
+        libc::SIGALRM,
+        libc::SIGVTALRM,
+        libc::SIGPROF,
+        libc::SIGXCPU,
+        libc::SIGIO,
+        libc::SIGPWR,
+        libc::SIGSTKFLT,
+        libc::SIGRTMIN(),
+        libc::SIGRTMAX(),
+    ];
+    // The last run starts with SIGHUP ignored: the SIGHUP it gets is no end, its SIGTERM is.
+    let runs = signals.iter().map(|&s| (s, None)).chain([(libc::SIGTERM, Some(libc::SIGHUP))]);
+    for (signal, ignored) in runs {
+        let mut command = Command::new(env!("CARGO_BIN_EXE_vstree"));
+        command.args(["reconstruct", input.to_str().unwrap(), output.to_str().unwrap(), "-q"]);
+        // SAFETY: only async-signal-safe calls between fork and exec. No core files from the
+        // signals that dump core (SIGQUIT, SIGXCPU).
+        unsafe {
+            command.pre_exec(move || {
+                let none = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+                libc::setrlimit(libc::RLIMIT_CORE, &none);
+                if let Some(ignored) = ignored {
+                    libc::signal(ignored, libc::SIG_IGN);
+                }
+                Ok(())
+            });
+        }
+        let mut child = command.spawn().unwrap();
         let start = Instant::now();
         let temporary = || {
             std::fs::read_dir(&dir)
@@ -201,6 +233,13 @@ fn an_interrupted_run_leaves_no_temporary_file() {
             assert!(start.elapsed() < Duration::from_secs(20), "no temporary output appeared");
             assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be interrupted");
             std::thread::sleep(Duration::from_millis(2));
+        }
+        if let Some(ignored) = ignored {
+            // SAFETY: the child is alive (not yet waited for).
+            unsafe { libc::kill(child.id() as libc::pid_t, ignored) };
+            std::thread::sleep(Duration::from_millis(200));
+            assert!(child.try_wait().unwrap().is_none(), "an ignored signal {ignored} ended the run");
+            assert!(temporary(), "an ignored signal {ignored} removed the temporary output");
         }
         // SAFETY: the child is alive (not yet waited for).
         unsafe { libc::kill(child.id() as libc::pid_t, signal) };
@@ -244,7 +283,7 @@ fn a_surface_far_from_its_samples_is_reported() {
 #[test]
 fn help_shows_the_library_defaults() {
     use vstree::reconstruct::ReconstructParams;
-    use vstree::tree::TreeParams;
+    use vstree::tree::{Metric, TreeParams};
     let default_of = |command: &str, flag: &str| -> String {
         let help = String::from_utf8(vstree(&[command, "--help"]).stdout).unwrap();
         let at = help.find(&format!("--{flag} <")).unwrap_or_else(|| panic!("{command} --help lacks --{flag}"));
@@ -265,7 +304,13 @@ fn help_shows_the_library_defaults() {
         let error = default_of(command, "error");
         assert_eq!(
             error,
-            format!("{:e} to simplify and for stats, {:e} to reconstruct", TreeParams::DEFAULT_ERROR, recon.tree.error)
+            format!(
+                "{:e} to simplify and for stats, {:e} to reconstruct; l21: {:e}; density: {}",
+                TreeParams::DEFAULT_ERROR,
+                recon.tree.error,
+                Metric::L21.default_error(),
+                Metric::Density.default_error()
+            )
         );
     }
     assert_eq!(number("reconstruct", "target"), recon.target_distance);
@@ -273,4 +318,97 @@ fn help_shows_the_library_defaults() {
     assert_eq!(number("reconstruct", "trim"), f64::from(recon.trim));
     assert_eq!(number("reconstruct", "neighbours"), recon.normals.neighbours as f64);
     assert_eq!(vstree::SimplifyParams::default().tree.error, TreeParams::DEFAULT_ERROR);
+}
+
+/// A reader that goes away (`vstree stats … | head -c 10`) ends the report quietly: no message,
+/// and the run ends with its own status, its output file written. A report that cannot be
+/// written (a full disk) is an error naming standard output.
+#[cfg(unix)]
+#[test]
+fn a_closed_or_full_standard_output_never_panics() {
+    use std::process::Stdio;
+    let dir = temp_dir("stdout");
+    let cloud = dir.join("cloud.xyz");
+    let mut points = shapes::sample_surface(&shapes::icosphere(1.0, 3), 3000, 2);
+    points.normals = None; // a report line before the work, about the estimated normals
+    io::write(&cloud, &points).unwrap();
+    let mesh = dir.join("sphere.ply");
+    io::write(&mesh, &shapes::icosphere(1.0, 3)).unwrap();
+    let output = dir.join("out.ply");
+    let closed_pipe = |args: &[&str]| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_vstree"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take()); // the reader is gone before the first line
+        child.wait_with_output().unwrap()
+    };
+    for args in [
+        vec!["stats", cloud.to_str().unwrap(), "--compare"],
+        vec!["simplify", cloud.to_str().unwrap(), output.to_str().unwrap()],
+        vec!["simplify", mesh.to_str().unwrap(), output.to_str().unwrap()],
+    ] {
+        let _ = std::fs::remove_file(&output);
+        let run = closed_pipe(&args);
+        assert_eq!(run.status.code(), Some(0), "{args:?}: {}", String::from_utf8_lossy(&run.stderr));
+        assert_eq!(String::from_utf8_lossy(&run.stderr), "", "{args:?}");
+        assert_eq!(output.exists(), args[0] == "simplify", "{args:?}");
+    }
+    let full = |args: &[&str]| {
+        let dev_full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+        Command::new(env!("CARGO_BIN_EXE_vstree")).args(args).stdout(dev_full).output().unwrap()
+    };
+    for args in [
+        vec!["simplify", mesh.to_str().unwrap(), output.to_str().unwrap()],
+        vec!["stats", cloud.to_str().unwrap()],
+        vec!["--help"],
+    ] {
+        let run = full(&args);
+        assert_eq!(run.status.code(), Some(1), "{args:?}");
+        assert_eq!(
+            String::from_utf8_lossy(&run.stderr),
+            "vstree: error: standard output: No space left on device (os error 28)\n",
+            "{args:?}"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A run stopped by the file-size limit (`ulimit -f`) fails like any other write: a message
+/// naming the output and the cause, exit code 1, no temporary file left and the old output
+/// untouched (instead of dying of SIGXFSZ with the temporary file left behind).
+#[cfg(unix)]
+#[test]
+fn a_file_size_limit_is_a_write_error() {
+    use std::os::unix::process::CommandExt;
+    let dir = temp_dir("fsize");
+    let input = dir.join("sphere.ply");
+    io::write(&input, &shapes::icosphere(1.0, 4)).unwrap();
+    let output = dir.join("out.ply");
+    std::fs::write(&output, "old").unwrap();
+    let mut command = Command::new(env!("CARGO_BIN_EXE_vstree"));
+    // A bound fine enough to keep most of the 2562 vertices: about 90 kB to write.
+    command.args(["simplify", input.to_str().unwrap(), output.to_str().unwrap(), "--error", "1e-9", "-q"]);
+    // SAFETY: setrlimit is async-signal-safe.
+    unsafe {
+        command.pre_exec(|| {
+            let limit = libc::rlimit { rlim_cur: 16 * 1024, rlim_max: 16 * 1024 };
+            libc::setrlimit(libc::RLIMIT_FSIZE, &limit);
+            Ok(())
+        });
+    }
+    let run = command.output().unwrap();
+    assert_eq!(run.status.code(), Some(1), "{:?}", run.status);
+    assert_eq!(
+        String::from_utf8_lossy(&run.stderr),
+        format!("vstree: error: {}: File too large (os error 27)\n", output.display())
+    );
+    assert_eq!(std::fs::read_to_string(&output).unwrap(), "old");
+    let mut names: Vec<String> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, vec!["out.ply", "sphere.ply"]);
+    std::fs::remove_dir_all(dir).unwrap();
 }

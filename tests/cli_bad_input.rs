@@ -186,12 +186,7 @@ fn cases() -> Vec<Case> {
         // Depth, cell size, threads.
         fail("simplify --max-depth 0", vec![sphere_ply()], &simplify_with(&["--max-depth", "0"]), error("--max-depth: 0: must be from 1 to 30")),
         fail("simplify --max-depth 31", vec![sphere_ply()], &simplify_with(&["--max-depth", "31"]), error("--max-depth: 31: must be from 1 to 30")),
-        usage(
-            "simplify --max-depth=-1",
-            vec![sphere_ply()],
-            &simplify_with(&["--max-depth=-1"]),
-            usage_error("invalid value '-1' for '--max-depth <MAX_DEPTH>': -1 is not in 0..=4294967295"),
-        ),
+        fail("simplify --max-depth=-1", vec![sphere_ply()], &simplify_with(&["--max-depth=-1"]), error("--max-depth: -1: must be from 1 to 30")),
         fail(
             "simplify --min-cell-size 1",
             vec![sphere_ply()],
@@ -206,12 +201,7 @@ fn cases() -> Vec<Case> {
         ),
         fail("simplify --threads 2000", vec![sphere_ply()], &simplify_with(&["--threads", "2000"]), contains(&["vstree: error: --threads: 2000 is absurd (0 = all cores, at most 1024)\n"])),
         fail("stats --threads 2000", vec![sphere_ply()], &stats_with(&["--threads", "2000"]), contains(&["vstree: error: --threads: 2000 is absurd (0 = all cores, at most 1024)\n"])),
-        usage(
-            "simplify --threads=-1",
-            vec![sphere_ply()],
-            &simplify_with(&["--threads=-1"]),
-            usage_error("invalid value '-1' for '--threads <THREADS>': invalid digit found in string"),
-        ),
+        fail("simplify --threads=-1", vec![sphere_ply()], &simplify_with(&["--threads=-1"]), error("--threads: -1: must be from 0 (all cores) to 1024")),
         usage("stats --threads x", vec![sphere_ply()], &stats_with(&["--threads", "x"]), usage_error("invalid value 'x' for '--threads <THREADS>': invalid digit found in string")),
         // Reconstruction's own flags.
         fail("reconstruct --levels 13", vec![cloud_ply()], &reconstruct_with(&["--levels", "13"]), error("--levels: 13: must be from 0 to 12")),
@@ -494,7 +484,129 @@ fn cases() -> Vec<Case> {
     long.quiet_stdout = false;
     long.creates = Some(long_name);
     cases.push(long);
+    cases.extend(flag_cases());
     cases
+}
+
+/// Negative values for every numeric flag, each metric's default bound, sizes that ignore the
+/// bound, and runs that would keep nothing of the shape, named by the flag that made them so.
+fn flag_cases() -> Vec<Case> {
+    let simplify_with = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut all = vec!["simplify", "in.ply", "out.ply"];
+        all.extend_from_slice(extra);
+        all
+    };
+    let reconstruct_with = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut all = vec!["reconstruct", "cloud.ply", "out.ply"];
+        all.extend_from_slice(extra);
+        all
+    };
+    let succeeds = |mut case: Case| {
+        (case.code, case.quiet_stdout, case.creates) = (0, false, Some("out.ply".into()));
+        case
+    };
+    // Two small spheres in opposite corners of the bounding box: each within one octant, so a
+    // tree of depth 1 (or one cell) collapses every triangle.
+    let mut apart = sphere();
+    let mut other = sphere();
+    for p in &mut apart.positions {
+        *p = *p * 0.1 - Vec3::splat(5.0);
+    }
+    for p in &mut other.positions {
+        *p = *p * 0.1 + Vec3::splat(5.0);
+    }
+    let offset = apart.positions.len() as u32;
+    apart.positions.extend(other.positions);
+    apart.triangles.extend(other.triangles.iter().map(|t| t.map(|v| v + offset)));
+    apart.normals = None;
+    let apart = || file("in.ply", Entry::Mesh(apart.clone()));
+    let plane: Vec<Vec3> = (0..900).map(|i| Vec3::new((i % 30) as f32, (i / 30) as f32, 0.0)).collect();
+    let flat = || file("cloud.ply", Entry::Mesh(points(plane.clone())));
+    let three = || file("cloud.ply", Entry::Mesh(points(vec![Vec3::ZERO, Vec3::X, Vec3::Y])));
+    let simplify_cloud = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut all = vec!["simplify", "cloud.ply", "out.ply", "-q"];
+        all.extend_from_slice(extra);
+        all
+    };
+    let collapsed_cloud = |n: usize| {
+        format!(
+            "--error: 0.001: all {n} points collapsed into one (1 cluster for the whole model): the model is within this \
+             bound of too few planes; use a smaller bound (a flat model, within any bound of one plane, needs the density metric)"
+        )
+    };
+    vec![
+        // A value starting with '-' is a value, whatever follows it.
+        fail("simplify --dd -inf", vec![sphere_ply()], &simplify_with(&["--dd", "-inf"]), error("--dd: -inf: must be in [0, 1]")),
+        fail("simplify --da -nan", vec![sphere_ply()], &simplify_with(&["--da", "-nan"]), error("--da: NaN: must be in [0, 1]")),
+        fail("simplify --error -1e-3", vec![sphere_ply()], &simplify_with(&["--error", "-1e-3"]), error("--error: -0.001: must be a finite number > 0")),
+        fail(
+            "simplify --min-cell-size -1e-9",
+            vec![sphere_ply()],
+            &simplify_with(&["--min-cell-size", "-1e-9"]),
+            error("--min-cell-size: -0.000000001: must be in [0, 1)"),
+        ),
+        fail("simplify --max-depth -1", vec![sphere_ply()], &simplify_with(&["--max-depth", "-1"]), error("--max-depth: -1: must be from 1 to 30")),
+        fail(
+            "simplify --max-depth 1e12",
+            vec![sphere_ply()],
+            &simplify_with(&["--max-depth", "99999999999"]),
+            error("--max-depth: 99999999999: must be from 1 to 30"),
+        ),
+        fail("stats --threads -2", vec![sphere_ply()], &["stats", "in.ply", "--threads", "-2"], error("--threads: -2: must be from 0 (all cores) to 1024")),
+        fail("simplify --ratio -1e-3", vec![sphere_ply()], &simplify_with(&["--ratio", "-1e-3"]), error("--ratio: -0.001: must be in (0, 1], a fraction of the input's triangles")),
+        fail("reconstruct --levels -1", vec![cloud_ply()], &reconstruct_with(&["--levels", "-1"]), error("--levels: -1: must be from 0 to 12")),
+        fail("reconstruct --neighbours -3", vec![cloud_ply()], &reconstruct_with(&["--neighbours", "-3"]), error("--neighbours: -3: must be from 3 to 256")),
+        fail("reconstruct --target -1e-9", vec![cloud_ply()], &reconstruct_with(&["--target", "-1e-9"]), error("--target: -0.000000001: must be a finite number >= 0")),
+        fail("reconstruct --trim -inf", vec![cloud_ply()], &reconstruct_with(&["--trim", "-inf"]), error("--trim: -inf: must be a finite number >= 0")),
+        // A ratio is a mesh's: on a cloud it is named as given.
+        fail(
+            "simplify a cloud --ratio 0.5",
+            vec![cloud_ply()],
+            &["simplify", "cloud.ply", "out.ply", "--ratio", "0.5", "-q"],
+            error("--ratio: 0.5: the input is a point cloud, with no triangles to take a fraction of: a ratio needs a mesh (use --error)"),
+        ),
+        // Each metric's own default bound; a size ignores the bound.
+        succeeds(fail("simplify --metric density", vec![sphere_ply()], &simplify_with(&["--metric", "density", "-q"]), exact(""))),
+        succeeds(fail("simplify --metric density --faces 500", vec![sphere_ply()], &simplify_with(&["--metric", "density", "--faces", "500", "-q"]), exact(""))),
+        succeeds(fail("simplify --metric l21 --ratio 0.5", vec![sphere_ply()], &simplify_with(&["--metric", "l21", "--ratio", "0.5", "-q"]), exact(""))),
+        Case { code: 0, quiet_stdout: false, ..fail("stats --metric density", vec![sphere_ply()], &["stats", "in.ply", "--metric", "density", "-q"], exact("")) },
+        // Everything collapsed: the flag that made the tree that coarse is named.
+        fail(
+            "simplify --max-depth 1 collapses every triangle",
+            vec![apart()],
+            &simplify_with(&["--max-depth", "1", "--no-keep-topology", "-q"]),
+            error("--max-depth: 1: every triangle collapsed (2 clusters for the whole model): the tree stopped at this depth, coarser than the bound asks; allow a deeper tree (default 24)"),
+        ),
+        fail(
+            "simplify --min-cell-size 0.99 collapses every triangle",
+            vec![apart()],
+            &simplify_with(&["--min-cell-size", "0.99", "--no-keep-topology", "-q"]),
+            error("--min-cell-size: 0.99: every triangle collapsed (1 cluster for the whole model): cells this small (relative to the diagonal) are not split, so the tree is coarser than the bound asks; use a smaller size (default 1e-7)"),
+        ),
+        fail(
+            "simplify --metric density --error 1e6 collapses every triangle",
+            vec![sphere_ply()],
+            &simplify_with(&["--metric", "density", "--error", "1e6", "--no-keep-topology", "-q"]),
+            error("--error: 1e6 samples per cell: every triangle collapsed (1 cluster for the whole model): the model has too few samples for clusters this large; use a smaller count (at least 1)"),
+        ),
+        // A cloud collapsed into one point: an error, as a mesh's collapse is; density splits it.
+        fail("simplify 3 points", vec![three()], &simplify_cloud(&[]), error(&collapsed_cloud(3))),
+        fail("simplify a flat cloud", vec![flat()], &simplify_cloud(&[]), error(&collapsed_cloud(900))),
+        fail(
+            "simplify 3 points --metric density",
+            vec![three()],
+            &simplify_cloud(&["--metric", "density"]),
+            error("--error: 16 samples per cell: all 3 points collapsed into one (1 cluster for the whole model): the model has too few samples for clusters this large; use a smaller count (at least 1)"),
+        ),
+        succeeds(fail("simplify 3 points --metric density --error 1", vec![three()], &simplify_cloud(&["--metric", "density", "--error", "1"]), exact(""))),
+        succeeds(fail("simplify a flat cloud --metric density", vec![flat()], &simplify_cloud(&["--metric", "density"]), exact(""))),
+        succeeds(fail(
+            "simplify identical points",
+            vec![file("cloud.ply", Entry::Mesh(points(vec![Vec3::splat(0.5); 50])))],
+            &simplify_cloud(&[]),
+            exact(""),
+        )),
+    ]
 }
 
 /// What a run did.

@@ -11,6 +11,63 @@ use vstree::simplify::{simplify, KeepTopology, SimplifyParams, SimplifyStats};
 use vstree::tree::{Metric, TreeKind, TreeParams, TreeStats};
 use vstree::{io, MeshSampling, Progress, SampleSet, Threads};
 
+/// Prints a line of the report on standard output through [`console::out`]; a failed write
+/// returns its error from the enclosing function.
+macro_rules! say {
+    ($($arg:tt)*) => {
+        console::out(format_args!($($arg)*))?
+    };
+}
+
+/// Prints a line on standard error through [`console::err`].
+macro_rules! warn {
+    ($($arg:tt)*) => {
+        console::err(format_args!($($arg)*))
+    };
+}
+
+/// The CLI's two streams, written without ever panicking (`println!` panics when a write
+/// fails).
+mod console {
+    use std::io::{ErrorKind, Write};
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    /// Set once the reader of standard output has gone.
+    static CLOSED: AtomicBool = AtomicBool::new(false);
+
+    /// Writes a line of the report on standard output. When the reader has gone (a pipe closed
+    /// early, as by `| head`), the rest of the report is dropped quietly and the run goes on:
+    /// its product is the output file, which is still wanted. Any other failure (a full disk)
+    /// is an error naming standard output.
+    pub fn out(line: std::fmt::Arguments) -> vstree::Result<()> {
+        if closed() {
+            return Ok(());
+        }
+        match writeln!(std::io::stdout().lock(), "{line}") {
+            Err(e) if e.kind() == ErrorKind::BrokenPipe => {
+                CLOSED.store(true, Ordering::Relaxed);
+                Ok(())
+            }
+            result => result.map_err(stdout_error),
+        }
+    }
+
+    /// Whether the reader of standard output has gone.
+    pub fn closed() -> bool {
+        CLOSED.load(Ordering::Relaxed)
+    }
+
+    /// A failed write to standard output as the error the user reads.
+    pub fn stdout_error(source: std::io::Error) -> vstree::Error {
+        vstree::Error::Io { path: "standard output".into(), source }
+    }
+
+    /// Writes a line on standard error; a failure is ignored, as there is nowhere left to say it.
+    pub fn err(line: std::fmt::Arguments) {
+        let _ = writeln!(std::io::stderr().lock(), "{line}");
+    }
+}
+
 #[derive(Parser)]
 #[command(
     name = "vstree",
@@ -32,6 +89,12 @@ enum Command {
     /// cloud without normals gets them estimated first. The size is set by the error bound
     /// (--error), or exactly by --faces or --ratio. A closed 2-manifold input keeps its
     /// topology unless --no-keep-topology is given.
+    ///
+    /// A run that would keep nothing of the shape is an error naming the flag that made the tree
+    /// that coarse (--error, --max-depth or --min-cell-size): a mesh whose every triangle
+    /// collapses, or a cloud whose every point collapses into one. A flat cloud (3 points are
+    /// one) is within any L2 or l21 bound of one plane: simplify it with --metric density,
+    /// which splits by sample count (--error 1 keeps every point).
     Simplify {
         /// Input file: .ply, .obj, .off, .xyz or .pwn.
         input: PathBuf,
@@ -47,11 +110,11 @@ enum Command {
         /// this count (within one triangle). Below what the topology allows (a closed surface
         /// of genus g needs more than 4 g triangles, a tetrahedron's 4 at least) the output is
         /// the smallest mesh reachable, and a warning says so. 0 = use the error bound.
-        #[arg(long, allow_negative_numbers = true, conflicts_with_all = ["ratio", "error"])]
+        #[arg(long, allow_hyphen_values = true, conflicts_with_all = ["ratio", "error"])]
         faces: Option<i64>,
         /// Fraction of the input's triangles wanted, in (0, 1] (instead of --error): 0.1 keeps
         /// 10%, rounded, at least 1 triangle; then as --faces.
-        #[arg(long, allow_negative_numbers = true, conflicts_with = "error")]
+        #[arg(long, allow_hyphen_values = true, conflicts_with = "error")]
         ratio: Option<f64>,
         /// Keep the topology: clusters merge by edge collapses that keep a closed 2-manifold
         /// closed and manifold with its genus (and an open one's borders manifold); a cluster
@@ -82,15 +145,15 @@ enum Command {
         tree: TreeArgs,
         /// Stop refining once the RMS distance from the samples to the mesh is at most this
         /// fraction of the bounding-box diagonal (0 = refine while the tree has detail left).
-        #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().target_distance)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().target_distance)]
         target: f64,
         /// Most refinement levels (each one multiplies the triangles by 4).
-        #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().max_levels)]
-        levels: u32,
+        #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().max_levels.into())]
+        levels: i64,
         /// Remove every face farther than this many grid cells from every sample, and make the
         /// output open (0 = no such trimming: open scans are found and cut at their border
         /// without it).
-        #[arg(long, allow_negative_numbers = true, default_value_t = ReconstructParams::default().trim)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().trim)]
         trim: f32,
         /// Keep only the part of the surface that the samples support, whatever its share: a
         /// scan's holes stay open too. By default the output is open only where much of the
@@ -112,8 +175,8 @@ enum Command {
         #[arg(long)]
         reorient: bool,
         /// Neighbours used to estimate normals (3-256).
-        #[arg(long, allow_negative_numbers = true, default_value_t = vstree::normals::DEFAULT_NEIGHBOURS)]
-        neighbours: usize,
+        #[arg(long, allow_hyphen_values = true, default_value_t = vstree::normals::DEFAULT_NEIGHBOURS as i64)]
+        neighbours: i64,
         /// Write PLY as text instead of binary.
         #[arg(long)]
         ascii: bool,
@@ -164,28 +227,29 @@ struct TreeArgs {
     /// diagonal of its cluster's point); l21: mean squared normal deviation (0-4); density:
     /// samples per cluster.
     /// Larger = coarser output (and, to reconstruct, smoother: it is the de-noising control).
-    /// [default: 1e-3 to simplify and for stats, 1e-5 to reconstruct]
-    #[arg(long, allow_negative_numbers = true)]
+    /// Given a size (--faces, --ratio), the bound is no bound and is not used.
+    /// [default: 1e-3 to simplify and for stats, 1e-5 to reconstruct; l21: 1e-3; density: 16]
+    #[arg(long, allow_hyphen_values = true)]
     error: Option<f64>,
     /// Normal-cone threshold of the height-field test, in [0, 1]: a cell becomes a surface
     /// (2D) node only if every normal's dot product with the mean normal exceeds it. Raise it
     /// for more adaptivity in curved areas.
-    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().d_a)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().d_a)]
     da: f32,
     /// Displacement threshold of the height-field test, in [0, 1]: a cell's height range over
     /// its radius must stay below it. Lower it for more adaptivity in curved areas.
-    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().d_d)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().d_d)]
     dd: f32,
     /// Deepest tree level (1-30).
-    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().max_depth)]
-    max_depth: u32,
+    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().max_depth.into())]
+    max_depth: i64,
     /// Cells smaller than this fraction of the bounding-box diagonal are not split, in [0, 1):
     /// guards against duplicate points.
-    #[arg(long, allow_negative_numbers = true, default_value_t = TreeParams::default().min_cell_size)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().min_cell_size)]
     min_cell_size: f64,
     /// Worker threads (0 = all cores).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0)]
-    threads: usize,
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
+    threads: i64,
     /// No progress bar and no report: print nothing but errors (`stats` still prints its
     /// statistics, which are its output).
     #[arg(long, short)]
@@ -237,36 +301,70 @@ impl From<Sampling> for MeshSampling {
 }
 
 impl TreeArgs {
-    fn params(&self, default_error: f64) -> TreeParams {
-        TreeParams {
+    /// The tree's parameters; without `--error`, the L2 metric's bound is `l2_error` (the
+    /// command's) and the other metrics' their own, in their units.
+    fn params(&self, l2_error: f64) -> vstree::Result<TreeParams> {
+        let metric = match self.metric {
+            MetricArg::L2 => Metric::L2,
+            MetricArg::L21 => Metric::L21,
+            MetricArg::Density => Metric::Density,
+        };
+        let default_error = if metric == Metric::L2 { l2_error } else { metric.default_error() };
+        Ok(TreeParams {
             kind: match self.tree {
                 Kind::Vstree => TreeKind::VsTree,
                 Kind::Octree => TreeKind::Octree,
             },
-            metric: match self.metric {
-                MetricArg::L2 => Metric::L2,
-                MetricArg::L21 => Metric::L21,
-                MetricArg::Density => Metric::Density,
-            },
+            metric,
             error: self.error.unwrap_or(default_error),
             d_a: self.da,
             d_d: self.dd,
-            max_depth: self.max_depth,
+            max_depth: unsigned("max_depth", self.max_depth, format_args!("from 1 to {}", vstree::tree::MAX_DEPTH))?,
             min_cell_size: self.min_cell_size,
-        }
+        })
+    }
+
+    /// `--threads`, checked for sign (the library checks the rest).
+    fn threads(&self) -> vstree::Result<usize> {
+        unsigned("threads", self.threads, format_args!("from 0 (all cores) to {}", Threads::MAX))
     }
 }
 
+/// An integer flag's value in the library's unsigned type. The flags are read as signed
+/// numbers so that a negative value is not taken for a flag; it never reaches the library's
+/// range check (nor does one too large for the type), so it is refused here with the flag's
+/// `range`, in the library's words.
+fn unsigned<T: TryFrom<i64>>(name: &'static str, value: i64, range: std::fmt::Arguments) -> vstree::Result<T> {
+    T::try_from(value)
+        .map_err(|_| vstree::Error::InvalidParameter { name, message: format!("{value}: must be {range}") })
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return parse_failure(&e),
+    };
     // Ctrl-C or a kill while an output is pending must not leave its hidden temporary file.
     io::remove_temporary_files_on_signals();
     match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("vstree: error: {}", message(&e));
+            warn!("vstree: error: {}", message(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Prints what the argument parser says (help and version on standard output, usage errors on
+/// standard error) and gives its exit code; help or version that cannot be written is an
+/// error, as any report is (a closed pipe is not).
+fn parse_failure(e: &clap::Error) -> ExitCode {
+    match e.print() {
+        Err(failure) if !e.use_stderr() && failure.kind() != std::io::ErrorKind::BrokenPipe => {
+            warn!("vstree: error: {}", console::stdout_error(failure));
+            ExitCode::FAILURE
+        }
+        _ => ExitCode::from(e.exit_code().clamp(0, 255) as u8),
     }
 }
 
@@ -333,7 +431,7 @@ fn read_with_normals(path: &Path, threads: usize, quiet: bool) -> vstree::Result
         let params = vstree::normals::NormalParams { threads, ..Default::default() };
         let report = with_progress(quiet, |p| vstree::normals::ensure_normals(&mut mesh, &params, p))?;
         if !quiet && report.estimated > 0 {
-            println!("normals: {} estimated from {} neighbours", report.estimated, report.neighbours);
+            say!("normals: {} estimated from {} neighbours", report.estimated, report.neighbours);
         }
     }
     Ok(mesh)
@@ -342,12 +440,13 @@ fn read_with_normals(path: &Path, threads: usize, quiet: bool) -> vstree::Result
 fn run(command: Command) -> vstree::Result<()> {
     match command {
         Command::Simplify { input, output, tree, sampling, faces, ratio, keep_topology, no_keep_topology, ascii } => {
-            let tree_params = tree.params(SIMPLIFY_ERROR);
+            let tree_params = tree.params(SIMPLIFY_ERROR)?;
             tree_params.check()?; // before reading what may be a large file
+            let threads = tree.threads()?;
             let size = Size::from_flags(faces, ratio)?;
             let target = reserve_output(&input, &output)?;
-            say_threads(tree.threads, tree.quiet);
-            let (mesh, read_s) = timed(|| read_with_normals(&input, tree.threads, tree.quiet))?;
+            say_threads(threads, tree.quiet);
+            let (mesh, read_s) = timed(|| read_with_normals(&input, threads, tree.quiet))?;
             let keep_topology = match (keep_topology, no_keep_topology) {
                 (true, _) => KeepTopology::On,
                 (_, true) => KeepTopology::Off,
@@ -356,14 +455,14 @@ fn run(command: Command) -> vstree::Result<()> {
             let params = SimplifyParams {
                 tree: tree_params,
                 sampling: sampling.into(),
-                threads: tree.threads,
+                threads,
                 keep_topology,
-                target_faces: size.faces(mesh.triangles.len()),
+                target_faces: size.faces(mesh.triangles.len())?,
             };
             let (out, stats) = with_progress(tree.quiet, |progress| simplify(&mesh, &params, progress))?;
             let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
-                print_simplify(&input, &output, &stats, read_s, write_s);
+                print_simplify(&input, &output, &stats, read_s, write_s)?;
             }
             say_size_missed(params.target_faces, &stats);
             Ok(())
@@ -383,12 +482,19 @@ fn run(command: Command) -> vstree::Result<()> {
             neighbours,
             ascii,
         } => {
+            let neighbours = unsigned(
+                "neighbours",
+                neighbours,
+                format_args!("from {} to {}", vstree::normals::MIN_NEIGHBOURS, vstree::normals::MAX_NEIGHBOURS),
+            )?;
             let normals = vstree::normals::NormalParams { neighbours, reorient_given: reorient, ..Default::default() };
+            let threads = tree.threads()?;
             let params = ReconstructParams {
                 normals,
-                tree: tree.params(ReconstructParams::default().tree.error),
+                tree: tree.params(ReconstructParams::default().tree.error)?,
                 target_distance: target,
-                max_levels: levels,
+                // The range ReconstructParams::check words.
+                max_levels: unsigned("max_levels", levels, format_args!("from 0 to 12"))?,
                 trim,
                 closure: match (open, closed) {
                     (true, _) => Closure::Open,
@@ -399,51 +505,55 @@ fn run(command: Command) -> vstree::Result<()> {
                     BaseMeshArg::Winding => BaseMesh::Winding,
                     BaseMeshArg::Paper => BaseMesh::Paper,
                 },
-                threads: tree.threads,
+                threads,
                 ..ReconstructParams::default()
             };
             params.check()?;
             let target = reserve_output(&input, &output)?;
-            say_threads(tree.threads, tree.quiet);
+            say_threads(threads, tree.quiet);
             let (mut cloud, read_s) = timed(|| io::read(&input))?;
             cloud.triangles.clear();
             let (out, stats) = with_progress(tree.quiet, |progress| reconstruct(&cloud, &params, progress))?;
             let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
             if !tree.quiet {
-                print_reconstruct(&input, &output, cloud.positions.len(), &stats, read_s, write_s);
+                print_reconstruct(&input, &output, cloud.positions.len(), &stats, read_s, write_s)?;
             }
             Ok(())
         }
         Command::Demo { out } => demo(&out),
         Command::Stats { input, tree, sampling, compare } => {
-            let tree_params = tree.params(SIMPLIFY_ERROR);
+            let tree_params = tree.params(SIMPLIFY_ERROR)?;
             tree_params.check()?;
-            say_threads(tree.threads, tree.quiet);
-            let mesh = read_with_normals(&input, tree.threads, tree.quiet)?;
+            let threads = tree.threads()?;
+            say_threads(threads, tree.quiet);
+            let mesh = read_with_normals(&input, threads, tree.quiet)?;
             let samples = if mesh.is_point_cloud() {
                 SampleSet::from_cloud(&mesh)?
             } else {
                 SampleSet::from_mesh(&mesh, sampling.into())?
             };
-            let threads = Threads::new(tree.threads)?;
+            let threads = Threads::new(threads)?;
             let mut kinds = vec![tree_params];
             if compare {
                 let other = if kinds[0].kind == TreeKind::VsTree { TreeKind::Octree } else { TreeKind::VsTree };
                 kinds.push(TreeParams { kind: other, ..kinds[0] });
             }
-            println!("{}: {} samples", input.display(), samples.len());
+            say!("{}: {} samples", input.display(), samples.len());
             let mut leaves = Vec::new();
             for params in kinds {
+                if console::closed() {
+                    return Ok(()); // the statistics are the output, and nobody reads them
+                }
                 let (built, seconds) = timed(|| {
                     with_progress(tree.quiet, |progress| vstree::tree::build(&samples, &params, &threads, progress))
                 })?;
                 let stats = built.stats();
-                println!("{:?}: built in {:.3} s", params.kind, seconds);
-                print_tree(&stats);
+                say!("{:?}: built in {:.3} s", params.kind, seconds);
+                print_tree(&stats)?;
                 leaves.push(stats.leaves);
             }
             if let [first, second] = leaves[..] {
-                println!("clusters: {first} vs {second} ({:+.1}%)", 100.0 * (first as f64 / second as f64 - 1.0));
+                say!("clusters: {first} vs {second} ({:+.1}%)", 100.0 * (first as f64 / second as f64 - 1.0));
             }
             Ok(())
         }
@@ -476,13 +586,22 @@ impl Size {
         }
     }
 
-    /// The `target_faces` for an input of `triangles` triangles.
-    fn faces(&self, triangles: usize) -> usize {
-        match *self {
+    /// The `target_faces` for an input of `triangles` triangles; a ratio of a point cloud's
+    /// (none) is refused, naming `--ratio` (a count is refused by the library).
+    fn faces(&self, triangles: usize) -> vstree::Result<usize> {
+        Ok(match *self {
             Size::Bound => 0,
             Size::Faces(n) => n,
+            Size::Ratio(r) if triangles == 0 => {
+                return Err(vstree::Error::InvalidParameter {
+                    name: "ratio",
+                    message: format!(
+                        "{r}: the input is a point cloud, with no triangles to take a fraction of: a ratio needs a mesh (use --error)"
+                    ),
+                })
+            }
             Size::Ratio(r) => ((r * triangles as f64).round() as usize).max(1),
-        }
+        })
     }
 }
 
@@ -498,7 +617,7 @@ fn say_size_missed(target: usize, s: &SimplifyStats) {
         } else {
             "the input has no more distinct clusters to give"
         };
-        eprintln!("vstree: warning: {} triangles instead of the {target} asked for: {why}", s.output_triangles);
+        warn!("vstree: warning: {} triangles instead of the {target} asked for: {why}", s.output_triangles);
     }
 }
 
@@ -510,7 +629,7 @@ fn say_threads(requested: usize, quiet: bool) {
     }
     let used = Threads::count_for(requested);
     if !quiet && requested > used {
-        eprintln!("vstree: --threads {requested}: this machine runs {used} at once; using {used}");
+        warn!("vstree: --threads {requested}: this machine runs {used} at once; using {used}");
     }
 }
 
@@ -536,80 +655,91 @@ fn with_progress<T>(quiet: bool, f: impl FnOnce(&mut Progress) -> vstree::Result
     result
 }
 
-fn print_tree(s: &TreeStats) {
-    println!("  nodes: {} (V {}, T {}, S {}), depth {}", s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.max_depth);
+fn print_tree(s: &TreeStats) -> vstree::Result<()> {
+    say!("  nodes: {} (V {}, T {}, S {}), depth {}", s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.max_depth);
     if s.t_nodes > 0 {
-        println!("  T-layer depth: {}..{}", s.t_depth_min, s.t_depth_max);
+        say!("  T-layer depth: {}..{}", s.t_depth_min, s.t_depth_max);
     }
-    println!(
+    say!(
         "  clusters (leaves): {}, samples per cluster: mean {:.1}, variance {:.1}",
-        s.leaves, s.leaf_size_mean, s.leaf_size_variance
+        s.leaves,
+        s.leaf_size_mean,
+        s.leaf_size_variance
     );
+    Ok(())
 }
 
-fn print_simplify(input: &Path, output: &Path, s: &SimplifyStats, read_s: f64, write_s: f64) {
-    println!("{}: {} vertices, {} triangles", input.display(), s.input_vertices, s.input_triangles);
-    println!("samples: {}", s.tree.samples);
-    print_tree(&s.tree);
-    println!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
-    println!("topology: {}", if s.kept_topology { "kept" } else { "not kept (plain clustering)" });
-    println!(
+fn print_simplify(input: &Path, output: &Path, s: &SimplifyStats, read_s: f64, write_s: f64) -> vstree::Result<()> {
+    say!("{}: {} vertices, {} triangles", input.display(), s.input_vertices, s.input_triangles);
+    say!("samples: {}", s.tree.samples);
+    print_tree(&s.tree)?;
+    say!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
+    say!("topology: {}", if s.kept_topology { "kept" } else { "not kept (plain clustering)" });
+    say!(
         "time: read {:.3} s, samples {:.3} s, tree {:.3} s, clustering {:.3} s, write {:.3} s",
-        read_s, s.seconds_samples, s.seconds_tree, s.seconds_cluster, write_s
+        read_s,
+        s.seconds_samples,
+        s.seconds_tree,
+        s.seconds_cluster,
+        write_s
     );
+    Ok(())
 }
 
-fn print_reconstruct(input: &Path, output: &Path, points: usize, s: &ReconstructStats, read_s: f64, write_s: f64) {
-    println!("{}: {} points", input.display(), points);
+fn print_reconstruct(
+    input: &Path,
+    output: &Path,
+    points: usize,
+    s: &ReconstructStats,
+    read_s: f64,
+    write_s: f64,
+) -> vstree::Result<()> {
+    say!("{}: {} points", input.display(), points);
     if s.normals.estimated > 0 {
-        println!("normals: {} estimated from {} neighbours", s.normals.estimated, s.normals.neighbours);
+        say!("normals: {} estimated from {} neighbours", s.normals.estimated, s.normals.neighbours);
     }
     if let Some(o) = &s.normals.orient {
-        println!("orientation: {} components, {} flipped", o.components, o.flipped);
+        say!("orientation: {} components, {} flipped", o.components, o.flipped);
     }
-    print_tree(&s.tree);
+    print_tree(&s.tree)?;
     let genus = s.base_genus.map_or("not a closed manifold".to_string(), |g| format!("genus {g}"));
     let thickened = if s.thickened { " (thickened: the plain one had handles through thin parts)" } else { "" };
-    println!("grid: {} cells across, {} triangles polygonised{thickened}", s.grid_cells, s.fine_triangles);
-    println!("M0: {} vertices, {} triangles, {genus}, error {:.2e}", s.base_vertices, s.base_triangles, s.base_error);
+    say!("grid: {} cells across, {} triangles polygonised{thickened}", s.grid_cells, s.fine_triangles);
+    say!("M0: {} vertices, {} triangles, {genus}, error {:.2e}", s.base_vertices, s.base_triangles, s.base_error);
     for (k, level) in s.levels.iter().enumerate() {
-        println!(
-            "level {}: {} new vertices, {} displaced by the quadtrees",
-            k + 1,
-            level.new_vertices,
-            level.displaced
-        );
+        say!("level {}: {} new vertices, {} displaced by the quadtrees", k + 1, level.new_vertices, level.displaced);
     }
     if s.stopped == RefinementStop::TriangleBudget {
-        eprintln!(
+        warn!(
             "warning: refinement stopped short of the target: another level would exceed the library's triangle budget"
         );
     }
-    println!("refinement stopped: {}", s.stopped.as_str());
-    println!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
+    say!("refinement stopped: {}", s.stopped.as_str());
+    say!("error: RMS {:.2e}, max {:.2e} (sample-to-mesh distance / diagonal)", s.final_error, s.final_max_error);
     let share = 100.0 * s.unsupported_share;
     if s.open {
-        println!("open: {share:.0}% of the closed surface is unsupported by the samples; kept: the part they support (--closed closes it)");
+        say!("open: {share:.0}% of the closed surface is unsupported by the samples; kept: the part they support (--closed closes it)");
     } else {
-        println!(
+        say!(
             "closed: {share:.0}% of the closed surface is unsupported by the samples, closed over (--open keeps it open)"
         );
     }
     if s.final_error > FAR_FROM_SAMPLES {
-        eprintln!(
+        warn!(
             "warning: the surface is far from the samples (RMS {:.1}% of the diagonal) and does not \
              represent this cloud",
             100.0 * s.final_error
         );
     }
     if s.trimmed_triangles > 0 {
-        println!("trimmed: {} triangles far from the samples", s.trimmed_triangles);
+        say!("trimmed: {} triangles far from the samples", s.trimmed_triangles);
     }
-    println!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
-    println!(
+    say!("{}: {} vertices, {} triangles", output.display(), s.output_vertices, s.output_triangles);
+    say!(
         "time: read {:.3} s, normals {:.3} s, tree {:.3} s, base mesh {:.3} s, refinement {:.3} s, trim {:.3} s, write {:.3} s",
         read_s, s.seconds_normals, s.seconds_tree, s.seconds_base, s.seconds_refine, s.seconds_trim, write_s
     );
+    Ok(())
 }
 
 /// The `demo` job: both algorithms on generated shapes whose answers are known.
@@ -623,18 +753,18 @@ fn demo(out: &Path) -> vstree::Result<()> {
         return Err(vstree::Error::Io { path: out.to_path_buf(), source: e });
     }
     std::fs::create_dir_all(out).map_err(|e| vstree::Error::Io { path: out.to_path_buf(), source: e })?;
-    println!("== simplification: a bumpy sphere, VS-Tree against octree at the same L2 bound (1e-5)");
+    say!("== simplification: a bumpy sphere, VS-Tree against octree at the same L2 bound (1e-5)");
     let mesh = shapes::bumpy_sphere(1.0, 0.08, 5.0, 8);
     let input = out.join("demo-sphere.ply");
     io::write(&input, &mesh)?;
-    println!("{}: {} vertices, {} triangles", input.display(), mesh.positions.len(), mesh.triangles.len());
+    say!("{}: {} vertices, {} triangles", input.display(), mesh.positions.len(), mesh.triangles.len());
     for (kind, name) in [(TreeKind::VsTree, "vstree"), (TreeKind::Octree, "octree")] {
         let params =
             SimplifyParams { tree: TreeParams { kind, error: 1e-5, ..TreeParams::default() }, ..Default::default() };
         let (simplified, stats) = with_progress(false, |p| simplify(&mesh, &params, p))?;
         let path = out.join(format!("demo-sphere-{name}.ply"));
         io::write(&path, &simplified)?;
-        println!(
+        say!(
             "{:7} {} clusters -> {}: {} triangles in {:.3} s",
             name,
             stats.tree.leaves,
@@ -644,7 +774,7 @@ fn demo(out: &Path) -> vstree::Result<()> {
         );
     }
 
-    println!("\n== reconstruction: 200k noisy points on a genus-3 pretzel");
+    say!("\n== reconstruction: 200k noisy points on a genus-3 pretzel");
     let mut cloud = shapes::sample_surface(&shapes::genus_n_pretzel(3), 200_000, 1);
     shapes::add_noise(&mut cloud, 0.002, 0.05, 2);
     let input = out.join("demo-pretzel-points.ply");
@@ -652,8 +782,8 @@ fn demo(out: &Path) -> vstree::Result<()> {
     let (mesh, stats) = with_progress(false, |p| reconstruct(&cloud, &ReconstructParams::default(), p))?;
     let output = out.join("demo-pretzel-reconstructed.ply");
     io::write(&output, &mesh)?;
-    print_reconstruct(&input, &output, cloud.positions.len(), &stats, 0.0, 0.0);
+    print_reconstruct(&input, &output, cloud.positions.len(), &stats, 0.0, 0.0)?;
     let report = topology::analyze(&mesh);
-    println!("result: watertight {}, genus {:?} (the shape has genus 3)", report.is_watertight(), report.genus());
+    say!("result: watertight {}, genus {:?} (the shape has genus 3)", report.is_watertight(), report.genus());
     Ok(())
 }

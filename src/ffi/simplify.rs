@@ -91,7 +91,9 @@ pub struct vstree_simplify_params {
     pub sampling: i32,
     /// Split threshold per cluster, read according to `metric`: L2, relative to the squared
     /// bounding-box diagonal, finite and > 0 (default 1e-3; larger = coarser); L2,1, unitless,
-    /// > 0 (useful range 1e-3 to 4); density, a sample count >= 1.
+    /// in (0, 4] (default 1e-3); density, a sample count >= 1 (default 16: the default 1e-3
+    /// left in place reads as 16 under density, where it means nothing). Ignored, and not
+    /// checked, when `target_faces` is set.
     pub error: f64,
     /// Height-field test, normal cone: a cell becomes a surface (2D) node only if every
     /// sample's normal has a dot product above `d_a` with the mean normal. Unitless, in [0, 1];
@@ -167,16 +169,21 @@ pub(crate) unsafe fn read_params(pointer: *const vstree_simplify_params) -> FfiR
         vstree_sampling::Vertices => MeshSampling::Vertices,
         vstree_sampling::FaceCenters => MeshSampling::FaceCenters,
     };
+    // The default struct holds L2's bound, which the density metric cannot read as a count.
+    let error = if metric == Metric::Density && p.error == vstree_simplify_params::defaults().error {
+        metric.default_error()
+    } else {
+        p.error
+    };
     let tree = TreeParams {
         kind,
         metric,
-        error: p.error,
+        error,
         d_a: p.d_a,
         d_d: p.d_d,
         max_depth: p.max_depth,
         min_cell_size: p.min_cell_size,
     };
-    tree.check()?;
     if p.threads > 1024 {
         return Err(super::Failure::parameter("threads", format!("{}: must be 0 (all cores) to 1024", p.threads)));
     }
@@ -185,13 +192,15 @@ pub(crate) unsafe fn read_params(pointer: *const vstree_simplify_params) -> FfiR
         vstree_keep_topology::On => KeepTopology::On,
         vstree_keep_topology::Off => KeepTopology::Off,
     };
-    Ok(SimplifyParams {
+    let params = SimplifyParams {
         tree,
         sampling,
         threads: p.threads as usize,
         keep_topology,
         target_faces: p.target_faces as usize,
-    })
+    };
+    params.check()?;
+    Ok(params)
 }
 
 /// What a simplification did. Owned by its result (vstree_simplify_result_get_stats()); later
@@ -261,7 +270,11 @@ pub struct vstree_simplify_result {
 /// Simplifies `mesh` (a triangle mesh, or a point cloud with normals) by clustering its
 /// samples in the tree `params` describes (NULL: defaults): every cluster becomes one vertex,
 /// triangles are re-indexed to them, and those that collapse or repeat are dropped. A point
-/// cloud gives one point with a normal per cluster.
+/// cloud gives one point with a normal per cluster. A result that keeps nothing of the shape
+/// fails with VSTREE_STATUS_INVALID_PARAMETER naming the parameter that made the tree that
+/// coarse (`error`, `max_depth` or `min_cell_size`): a mesh whose every triangle collapses, or a
+/// cloud whose every point collapses into one (a flat cloud, 3 points among them, is within any
+/// L2 or L2,1 bound of one plane: the density metric splits it).
 ///
 /// `progress` (may be NULL) is called with `user_data` from the calling thread as the work
 /// goes; returning 0 from it cancels. On success the new result is written to `*out_result`

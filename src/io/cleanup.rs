@@ -1,12 +1,13 @@
-//! Removing temporary output files when the process is interrupted (Ctrl-C, SIGTERM, SIGHUP),
-//! so an interrupted write leaves no hidden partial file behind.
+//! Removing temporary output files when the process is ended by a signal (Ctrl-C, SIGTERM,
+//! SIGHUP, a timer, a CPU limit, ...) or stopped by a file-size limit, so an interrupted write
+//! leaves no hidden partial file behind.
 //!
 //! A program opts in with [`remove_temporary_files_on_signals`] (the CLI does); a library
-//! inside a host application never installs signal handlers of its own, and then nothing is
-//! registered. The handler may only call async-signal-safe functions, so the paths live in a
-//! fixed table of C strings that it reads without locks; once handlers are installed, a
-//! released path's string is left allocated (a few bytes per written file), since a handler
-//! running on another thread may still be reading it.
+//! inside a host application (MeshLab, Blender, Python) never installs signal handlers of its
+//! own, and then nothing is registered. The handler may only call async-signal-safe functions,
+//! so the paths live in a fixed table of C strings that it reads without locks; once handlers
+//! are installed, a released path's string is left allocated (a few bytes per written file),
+//! since a handler running on another thread may still be reading it.
 
 use std::ffi::{c_char, CString};
 use std::path::Path;
@@ -50,24 +51,58 @@ impl Drop for Registration {
     }
 }
 
-/// Installs handlers for SIGINT, SIGTERM and SIGHUP that delete every pending temporary
-/// output file and then end the process as the signal would have. For programs, not for
-/// libraries loaded into a host. Does nothing on platforms without POSIX signals.
+/// Installs handlers that delete every pending temporary output file and then end the process
+/// as the signal would have, for every signal that ends a process by default and can be caught
+/// ([`terminating_signals`]); a signal the process was started with ignored (`nohup`, a
+/// background job's Ctrl-C) stays ignored. SIGXFSZ is ignored, so that a write beyond the
+/// file-size limit (`ulimit -f`) fails with EFBIG like any write error: the temporary file is
+/// removed and the error names the output. For programs, not for libraries loaded into a host.
+/// Does nothing on platforms without POSIX signals.
 pub fn remove_temporary_files_on_signals() {
     #[cfg(unix)]
     {
         INSTALLED.store(true, Ordering::Release);
-        for signal in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+        // SAFETY: setting a signal's disposition to "ignore" has no preconditions.
+        unsafe { libc::signal(libc::SIGXFSZ, libc::SIG_IGN) };
+        for signal in terminating_signals() {
             // SAFETY: `on_signal` is an `extern "C" fn(c_int)` that only calls async-signal-safe
-            // functions; the sigaction struct is fully initialised.
+            // functions; the sigaction structs are fully initialised.
             unsafe {
+                let mut old: libc::sigaction = std::mem::zeroed();
+                if libc::sigaction(signal, ptr::null(), &mut old) != 0 || old.sa_sigaction == libc::SIG_IGN {
+                    continue;
+                }
                 let mut action: libc::sigaction = std::mem::zeroed();
                 action.sa_sigaction = on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t;
-                libc::sigemptyset(&mut action.sa_mask);
+                // Other signals wait while the files are removed.
+                libc::sigfillset(&mut action.sa_mask);
                 libc::sigaction(signal, &action, ptr::null_mut());
             }
         }
     }
+}
+
+/// The signals whose default action ends the process and that a handler can catch (SIGKILL
+/// and SIGSTOP cannot be; SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT and SIGTRAP report a fault
+/// of the process itself, and SIGPIPE is ignored by Rust programs).
+#[cfg(unix)]
+fn terminating_signals() -> Vec<libc::c_int> {
+    use libc::*;
+    #[allow(unused_mut)]
+    let mut signals = vec![SIGHUP, SIGINT, SIGTERM, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU];
+    // SIGIO (SIGPOLL) and SIGPWR end a process on Linux only (BSDs ignore or lack them); the
+    // real-time signals exist there only.
+    #[cfg(target_os = "linux")]
+    {
+        signals.extend([SIGIO, SIGPWR]);
+        signals.extend(SIGRTMIN()..=SIGRTMAX());
+    }
+    #[cfg(all(
+        target_os = "linux",
+        not(any(target_arch = "mips", target_arch = "mips64", target_arch = "sparc", target_arch = "sparc64"))
+    ))]
+    signals.push(SIGSTKFLT);
+    signals
 }
 
 #[cfg(unix)]
@@ -97,5 +132,38 @@ fn c_string(path: &Path) -> Option<CString> {
     {
         let _ = path;
         None
+    }
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+
+    /// Every disposition [`remove_temporary_files_on_signals`] would change.
+    fn dispositions() -> Vec<libc::sighandler_t> {
+        let signals = terminating_signals().into_iter().chain([libc::SIGXFSZ]);
+        signals
+            .map(|signal| {
+                // SAFETY: reading a signal's action into a zeroed struct.
+                unsafe {
+                    let mut action: libc::sigaction = std::mem::zeroed();
+                    libc::sigaction(signal, ptr::null(), &mut action);
+                    action.sa_sigaction
+                }
+            })
+            .collect()
+    }
+
+    /// A library inside a host (this test process stands for one) writes its files with no
+    /// signal handler of its own: only a program's explicit opt-in installs them.
+    #[test]
+    fn writing_through_the_library_installs_no_signal_handler() {
+        let before = dispositions();
+        let dir = std::env::temp_dir().join(format!("vstree-cleanup-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        crate::io::write(&dir.join("a.ply"), &crate::eval::shapes::icosphere(1.0, 1)).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(!INSTALLED.load(Ordering::Acquire));
+        assert_eq!(dispositions(), before);
     }
 }

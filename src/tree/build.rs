@@ -257,8 +257,7 @@ impl Builder {
     /// small, too deep or a single sample; returns the children with their sums.
     pub(super) fn split(&self, part: &mut Part, i: usize, threads: Option<&Threads>) -> Vec<Pending> {
         let node = part.nodes[i];
-        let splittable = node.count > 1 && u32::from(node.depth) < self.params.max_depth && node.half > self.min_half;
-        if !splittable {
+        if node.count <= 1 || self.limit(&node).is_some() {
             return Vec::new();
         }
         match node.kind {
@@ -269,6 +268,19 @@ impl Builder {
                 self.split_quadrants(part, i, center, f.square_half, threads)
             }
             NodeKind::Surface => self.split_quadrants(part, i, node.center, node.half, threads),
+        }
+    }
+
+    /// The limit that keeps `node` from being split, by its parameter's name: `max_depth` at the
+    /// deepest level allowed, `min_cell_size` for a cell that small; None when its bound (or a
+    /// single sample) decides.
+    pub(super) fn limit(&self, node: &Node) -> Option<&'static str> {
+        if u32::from(node.depth) >= self.params.max_depth {
+            Some("max_depth")
+        } else if node.half <= self.min_half {
+            Some("min_cell_size")
+        } else {
+            None
         }
     }
 

@@ -175,6 +175,19 @@ pub fn representative(node: &Node, frame: Option<&Frame>, stats: &CellStats, ori
 }
 
 impl Metric {
+    /// The bound a tree is built with when none is given, in this metric's units: for L2 (a
+    /// relative error) [`TreeParams::DEFAULT_ERROR`], the simplification's (reconstruction has
+    /// its own); for L2,1 (unitless) the same number; for density, 16 samples per cell.
+    pub fn default_error(self) -> f64 {
+        match self {
+            Metric::L2 | Metric::L21 => TreeParams::DEFAULT_ERROR,
+            // Samples per cell: a cell of more is split in 4 to 8, so a cluster holds about 8
+            // samples (8.0 to 8.8 on a sampled torus and its cloud, where the L2 default gives
+            // 9.4): about the L2 default's reduction, whatever the model's size.
+            Metric::Density => 16.0,
+        }
+    }
+
     /// The error of a cell under this metric, as the split test measures it before comparing:
     /// L2, the quadric at the cell's [`representative`] (absolute, squared units); L2,1, the
     /// normal deviation; density, the sample count. `stats` sums the cell's samples relative to
@@ -317,6 +330,18 @@ impl VsTree {
             }
             Metric::L21 | Metric::Density => error,
         }
+    }
+
+    /// The parameter that made the tree coarser than its bound asks: the limit (`max_depth` or
+    /// `min_cell_size`) that kept a leaf beyond the bound from being split, by its name; None
+    /// when every leaf is within the bound or a single sample. For a tree as [`build`] made it
+    /// (not reshaped by [`fit`]).
+    pub fn limited_by(&self) -> Option<&'static str> {
+        let builder = build::Builder::new(&self.params, self.root().center, self.diagonal);
+        self.leaves()
+            .map(|i| &self.nodes[i])
+            .filter(|node| node.count > 1 && self.node_error(node) > self.params.error)
+            .find_map(|node| builder.limit(node))
     }
 
     /// [`VsTree::node_error`] of each of the nodes numbered `nodes`, in parallel.

@@ -7,6 +7,7 @@
 #include "common.h"
 
 #include <limits.h>
+#include <signal.h>
 #include <stdint.h>
 
 #ifndef EXPECTED_VERSION
@@ -1014,6 +1015,24 @@ static void sized_simplification(const vstree_mesh *mesh) {
   }
 }
 
+/* The library inside a host installs no signal handler of its own (only the vstree program
+ * does, to remove its temporary output): writing a file and simplifying leave SIGINT and
+ * SIGTERM as the host set them. */
+static void host_signals_untouched(const vstree_mesh *mesh) {
+  char path[4096];
+  vstree_simplify_result *r = NULL;
+  void (*before_int)(int) = signal(SIGINT, SIG_DFL);
+  void (*before_term)(int) = signal(SIGTERM, SIG_DFL);
+  signal(SIGINT, before_int);
+  signal(SIGTERM, before_term);
+  EXPECT(VSTREE_STATUS_OK, NULL, vstree_mesh_save(mesh, path_in_dir(path, sizeof path, "signals.ply"), 0));
+  EXPECT(VSTREE_STATUS_OK, NULL, vstree_simplify(mesh, NULL, NULL, NULL, &r));
+  vstree_simplify_result_free(r);
+  remove(path);
+  CHECK(signal(SIGINT, before_int) == before_int);
+  CHECK(signal(SIGTERM, before_term) == before_term);
+}
+
 int main(int argc, char **argv) {
   torus t = make_torus(48, 24, 0.2f);
   vstree_mesh *mesh, *cloud, *cloud_no_normals, *mesh_no_normals;
@@ -1038,6 +1057,7 @@ int main(int argc, char **argv) {
   reconstruction(cloud, cloud_no_normals);
   normal_estimation(&t, cloud_no_normals, mesh_no_normals);
   sized_simplification(mesh);
+  host_signals_untouched(mesh);
 
   vstree_mesh_free(mesh);
   vstree_mesh_free(cloud);

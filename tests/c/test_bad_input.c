@@ -1117,6 +1117,47 @@ CALL(save_through_dangling_link) {
 CALL(save_into_missing_folder) { return save(g_mesh, "no-such-dir/out.ply", 0); }
 CALL(save_over_directory) { return save(g_mesh, "sub.ply", 0); }
 
+/* Metric defaults, sizes that ignore the bound, and results that keep nothing of the shape */
+CALL(simplify_density_default_bound) {
+  vstree_simplify_params p = vstree_simplify_params_default();
+  p.metric = VSTREE_METRIC_DENSITY;
+  return simplify_with(g_mesh, &p);
+}
+CALL(simplify_density_size_ignores_bound) {
+  vstree_simplify_params p = vstree_simplify_params_default();
+  p.metric = VSTREE_METRIC_DENSITY;
+  p.error = 0.5;
+  p.target_faces = 300;
+  return simplify_with(g_mesh, &p);
+}
+CALL(simplify_size_ignores_nan_bound) {
+  vstree_simplify_params p = vstree_simplify_params_default();
+  p.error = NAN;
+  p.target_faces = 300;
+  return simplify_with(g_mesh, &p);
+}
+CALL(simplify_min_cell_collapses_all) {
+  vstree_simplify_params p = vstree_simplify_params_default();
+  p.min_cell_size = 0.99;
+  p.keep_topology = VSTREE_KEEP_TOPOLOGY_OFF;
+  return simplify_with(g_mesh, &p);
+}
+static vstree_status three_points(double error, int32_t metric) {
+  static const float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  static const float n[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+  vstree_simplify_params params = vstree_simplify_params_default();
+  vstree_mesh *cloud = NULL;
+  vstree_status s = vstree_mesh_create(p, 3, n, NULL, 0, &cloud);
+  if (s != VSTREE_STATUS_OK) return s;
+  params.metric = metric;
+  params.error = error;
+  s = simplify_with(cloud, &params);
+  vstree_mesh_free(cloud);
+  return s;
+}
+CALL(simplify_three_points) { return three_points(1e-3, VSTREE_METRIC_L2); }
+CALL(simplify_three_points_density_1) { return three_points(1.0, VSTREE_METRIC_DENSITY); }
+
 #define ROW(call, status, message) {#call, call, VSTREE_STATUS_##status, message}
 
 static const bad_case g_cases[] = {
@@ -1721,6 +1762,19 @@ static const bad_case g_cases[] = {
     ROW(cancel_reconstruct_first, CANCELLED, "vstree_reconstruct: cancelled"),
     ROW(cancel_normals_first, CANCELLED, "vstree_estimate_normals: cancelled"),
     ROW(cancel_normals_done, CANCELLED, "vstree_estimate_normals: cancelled"),
+
+    ROW(simplify_density_default_bound, OK, ""),
+    ROW(simplify_density_size_ignores_bound, OK, ""),
+    ROW(simplify_size_ignores_nan_bound, OK, ""),
+    ROW(simplify_min_cell_collapses_all, INVALID_PARAMETER,
+        "vstree_simplify: parameter `min_cell_size`: 0.99: every triangle collapsed (1 cluster for "
+        "the whole model): cells this small (relative to the diagonal) are not split, so the tree "
+        "is coarser than the bound asks; use a smaller size (default 1e-7)"),
+    ROW(simplify_three_points, INVALID_PARAMETER,
+        "vstree_simplify: parameter `error`: 0.001: all 3 points collapsed into one (1 cluster for "
+        "the whole model): the model is within this bound of too few planes; use a smaller bound (a "
+        "flat model, within any bound of one plane, needs the density metric)"),
+    ROW(simplify_three_points_density_1, OK, ""),
 };
 
 /* ---- matching and the run ---- */
