@@ -70,7 +70,7 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 4
+#define VSTREE_VERSION_MINOR 5
 
 /**
  * Patch version (semver).
@@ -1175,7 +1175,8 @@ size_t vstree_last_error_copy(char *buffer, size_t capacity);
  *
  * - `positions`: 3 × `vertex_count` floats, x y z per vertex, finite and at most 1e18 in
  *   magnitude (squares of coordinate differences must fit a float). `vertex_count` must be
- *   at least 1 and at most 2^32 - 1.
+ *   at least 1 and at most 2^32 - 1. Coordinates far from the origin (georeferenced, say)
+ *   lose their detail in float: give them as doubles to vstree_mesh_create_f64().
  * - `normals`: NULL, or 3 × `vertex_count` floats, one normal per vertex (any length but
  *   zero; they are normalised where used). Point clouds need normals to be simplified.
  * - `triangles`: 3 × `triangle_count` vertex indices (counter-clockwise seen from outside;
@@ -1194,6 +1195,27 @@ vstree_status vstree_mesh_create(const float *positions,
                                  const uint32_t *triangles,
                                  size_t triangle_count,
                                  struct vstree_mesh **out_mesh);
+
+/**
+ * Like vstree_mesh_create(), with the positions in double precision: 3 × `vertex_count`
+ * doubles, x y z per vertex. They are kept as a file's are: a model far from the origin for
+ * its size (more than 16 times its extent away, as georeferenced coordinates at 1e6 or 1e8
+ * are) is stored in float relative to the centre of its bounding box, so its detail
+ * survives, and vstree_mesh_copy_positions_f64() gives the positions back to within float
+ * rounding of their distance to that centre; a model nearer the origin is stored as floats.
+ * Results made from the mesh carry its origin, and vstree_mesh_save() writes them in double.
+ * Since 0.5.0.
+ *
+ * Fails like vstree_mesh_create(); a position is refused when it is NaN, infinite or beyond
+ * 1e18 in magnitude (the message names the vertex and its coordinates), and `positions` must
+ * be aligned to 8 bytes. Thread-safe.
+ */
+vstree_status vstree_mesh_create_f64(const double *positions,
+                                     size_t vertex_count,
+                                     const float *normals,
+                                     const uint32_t *triangles,
+                                     size_t triangle_count,
+                                     struct vstree_mesh **out_mesh);
 
 /**
  * Reads a mesh or point cloud from the file at `path` (NUL-terminated; UTF-8, or any bytes on

@@ -117,3 +117,29 @@ fn float_input_far_away_reads_and_writes_back_exactly() {
         assert_eq!(back.triangles.len(), if name.ends_with("xyz") { 0 } else { moved.triangles.len() }, "{name}");
     }
 }
+
+#[test]
+fn doubles_given_through_the_c_api_keep_their_detail_far_away() {
+    use std::ptr::null;
+    use vstree::ffi::{mesh::*, vstree_status};
+    // A unit sphere at 1e6 and 1e8, given in doubles as a host with georeferenced data would:
+    // float coordinates there are 1/16 and 8 apart; kept as a file's positions are, every
+    // radius is within 1e-6 of 1.
+    let sphere = shapes::icosphere(1.0, 4);
+    for offset in [1e6, 1e8] {
+        let moved: Vec<f64> = sphere.positions.iter().flat_map(|p| (p.as_dvec3() + offset).to_array()).collect();
+        let triangles: Vec<u32> = sphere.triangles.iter().flatten().copied().collect();
+        let (n, t) = (sphere.positions.len(), sphere.triangles.len());
+        let mut handle = std::ptr::null_mut();
+        let status = unsafe { vstree_mesh_create_f64(moved.as_ptr(), n, null(), triangles.as_ptr(), t, &mut handle) };
+        assert_eq!(status, vstree_status::Ok, "offset {offset:e}");
+        let mut back = vec![0f64; 3 * n];
+        assert_eq!(unsafe { vstree_mesh_copy_positions_f64(handle, back.as_mut_ptr(), back.len()) }, vstree_status::Ok);
+        assert_eq!(unsafe { vstree_mesh_triangle_count(handle) }, t);
+        unsafe { vstree_mesh_free(handle) };
+        let worst =
+            back.chunks(3).map(|c| (DVec3::from_slice(c) - offset).length() - 1.0).fold(0.0, |w, e| e.abs().max(w));
+        // The sphere's own rounding in f32 is 6e-8 of it.
+        assert!(worst < 1e-6, "offset {offset:e}: radius error {worst:e}");
+    }
+}

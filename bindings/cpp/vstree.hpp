@@ -146,6 +146,13 @@ public:
     detail::check(vstree_mesh_copy_positions(m_, out.data(), out.size()));
     return out;
   }
+  /** x y z per vertex in double: the exact positions of a model far from the origin (see
+   * vstree_mesh_copy_positions_f64()). */
+  std::vector<double> positions_f64() const {
+    std::vector<double> out(3 * vertex_count());
+    detail::check(vstree_mesh_copy_positions_f64(m_, out.data(), out.size()));
+    return out;
+  }
   /** x y z per vertex; empty when the mesh has no normals. */
   std::vector<float> normals() const {
     std::vector<float> out;
@@ -179,16 +186,24 @@ public:
   static mesh create(const std::vector<float> &positions,
                      const std::vector<uint32_t> &triangles = std::vector<uint32_t>(),
                      const std::vector<float> &normals = std::vector<float>()) {
-    if (positions.size() % 3 != 0 || triangles.size() % 3 != 0 ||
-        (!normals.empty() && normals.size() != positions.size())) {
-      throw error(VSTREE_STATUS_INVALID_ARGUMENT,
-                  "vstree::mesh::create: array sizes must be multiples of 3, with as many "
-                  "normals as positions");
-    }
+    check_sizes(positions.size(), triangles.size(), normals.size(), "create");
     vstree_mesh *m = nullptr;
     detail::check(vstree_mesh_create(positions.data(), positions.size() / 3,
                                      normals.empty() ? nullptr : normals.data(),
                                      triangles.data(), triangles.size() / 3, &m));
+    return mesh(m);
+  }
+  /** As create(), with double positions, kept as a file's are: a model far from the origin
+   * keeps its detail (see vstree_mesh_create_f64()). Its own name, not an overload of
+   * create(): a braced list of numbers would fit both. */
+  static mesh create_f64(const std::vector<double> &positions,
+                         const std::vector<uint32_t> &triangles = std::vector<uint32_t>(),
+                         const std::vector<float> &normals = std::vector<float>()) {
+    check_sizes(positions.size(), triangles.size(), normals.size(), "create_f64");
+    vstree_mesh *m = nullptr;
+    detail::check(vstree_mesh_create_f64(positions.data(), positions.size() / 3,
+                                         normals.empty() ? nullptr : normals.data(),
+                                         triangles.data(), triangles.size() / 3, &m));
     return mesh(m);
   }
   /** Reads .ply, .obj, .off, .xyz or .pwn. */
@@ -212,11 +227,22 @@ public:
   std::size_t triangle_count() const noexcept { return view().triangle_count(); }
   bool has_normals() const noexcept { return view().has_normals(); }
   std::vector<float> positions() const { return view().positions(); }
+  std::vector<double> positions_f64() const { return view().positions_f64(); }
   std::vector<float> normals() const { return view().normals(); }
   std::vector<uint32_t> triangles() const { return view().triangles(); }
   void save(const std::string &path, bool ascii = false) const { view().save(path, ascii); }
 
 private:
+  /** The array sizes create() and create_f64() need: x y z triples, as many normals as
+   * positions. */
+  static void check_sizes(std::size_t positions, std::size_t triangles, std::size_t normals,
+                          const char *function) {
+    if (positions % 3 != 0 || triangles % 3 != 0 || (normals != 0 && normals != positions)) {
+      throw error(VSTREE_STATUS_INVALID_ARGUMENT,
+                  std::string("vstree::mesh::") + function +
+                      ": array sizes must be multiples of 3, with as many normals as positions");
+    }
+  }
   detail::handle<vstree_mesh, vstree_mesh_free> h_;
 };
 

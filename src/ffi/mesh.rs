@@ -3,9 +3,9 @@
 
 use super::arrays::{self, copy_out, elements, input};
 use super::{guard, guard_or, handle, non_null, vstree_status, write_out, Failure, FfiResult};
-use crate::io::{self, Format, WriteOptions};
+use crate::io::{self, assemble, Format, WriteOptions};
 use crate::mesh::Mesh;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::ffi::{c_char, c_void, CStr};
 use std::path::{Path, PathBuf};
 
@@ -22,6 +22,8 @@ pub struct vstree_mesh {
 
 // Vertices cross the boundary as packed float triples; glam's Vec3 is exactly that.
 const _: () = assert!(std::mem::size_of::<Vec3>() == 12 && std::mem::align_of::<Vec3>() == 4);
+// Double positions too, as DVec3.
+const _: () = assert!(std::mem::size_of::<DVec3>() == 24 && std::mem::align_of::<DVec3>() == 8);
 
 /// `vstree_mesh_save` flag: write PLY as ASCII text instead of binary little-endian.
 pub const VSTREE_SAVE_ASCII: u32 = 1;
@@ -58,7 +60,8 @@ fn triples<T: Copy, U: Copy>(flat: &[T], what: &str) -> FfiResult<Vec<U>> {
 ///
 /// - `positions`: 3 × `vertex_count` floats, x y z per vertex, finite and at most 1e18 in
 ///   magnitude (squares of coordinate differences must fit a float). `vertex_count` must be
-///   at least 1 and at most 2^32 - 1.
+///   at least 1 and at most 2^32 - 1. Coordinates far from the origin (georeferenced, say)
+///   lose their detail in float: give them as doubles to vstree_mesh_create_f64().
 /// - `normals`: NULL, or 3 × `vertex_count` floats, one normal per vertex (any length but
 ///   zero; they are normalised where used). Point clouds need normals to be simplified.
 /// - `triangles`: 3 × `triangle_count` vertex indices (counter-clockwise seen from outside;
@@ -79,32 +82,83 @@ pub unsafe extern "C" fn vstree_mesh_create(
     triangle_count: usize,
     out_mesh: *mut *mut vstree_mesh,
 ) -> vstree_status {
-    guard("vstree_mesh_create", || {
-        non_null(out_mesh, "out_mesh")?;
-        let floats = elements(vertex_count, 3, "vertex_count")?;
-        let indices = elements(triangle_count, 3, "triangle_count")?;
-        if vertex_count == 0 {
-            return Err(Failure::new(
-                vstree_status::InvalidInput,
-                "`vertex_count` is 0: a mesh needs at least one vertex",
-            ));
-        }
-        // SAFETY (all three): the caller gives arrays of the documented lengths.
-        let positions = unsafe { input(positions, floats, "positions") }?;
-        let normals = match normals.is_null() {
-            true => None,
-            false => Some(unsafe { input(normals, floats, "normals") }?),
-        };
-        let triangles = unsafe { input(triangles, indices, "triangles") }?;
-        let mesh = Mesh::new(
-            triples::<f32, Vec3>(positions, "positions")?,
-            normals.map(|n| triples::<f32, Vec3>(n, "normals")).transpose()?,
-            triples::<u32, [u32; 3]>(triangles, "triangles")?,
-        );
-        mesh.check()?;
-        unsafe { write_out(out_mesh, into_handle(mesh)) };
-        Ok(())
+    guard("vstree_mesh_create", || unsafe {
+        create(positions, vertex_count, normals, triangles, triangle_count, out_mesh, |p, n, t| {
+            Ok(Mesh::new(triples::<f32, Vec3>(p, "positions")?, n, t))
+        })
     })
+}
+
+/// Like vstree_mesh_create(), with the positions in double precision: 3 × `vertex_count`
+/// doubles, x y z per vertex. They are kept as a file's are: a model far from the origin for
+/// its size (more than 16 times its extent away, as georeferenced coordinates at 1e6 or 1e8
+/// are) is stored in float relative to the centre of its bounding box, so its detail
+/// survives, and vstree_mesh_copy_positions_f64() gives the positions back to within float
+/// rounding of their distance to that centre; a model nearer the origin is stored as floats.
+/// Results made from the mesh carry its origin, and vstree_mesh_save() writes them in double.
+/// Since 0.5.0.
+///
+/// Fails like vstree_mesh_create(); a position is refused when it is NaN, infinite or beyond
+/// 1e18 in magnitude (the message names the vertex and its coordinates), and `positions` must
+/// be aligned to 8 bytes. Thread-safe.
+#[no_mangle]
+pub unsafe extern "C" fn vstree_mesh_create_f64(
+    positions: *const f64,
+    vertex_count: usize,
+    normals: *const f32,
+    triangles: *const u32,
+    triangle_count: usize,
+    out_mesh: *mut *mut vstree_mesh,
+) -> vstree_status {
+    guard("vstree_mesh_create_f64", || unsafe {
+        create(positions, vertex_count, normals, triangles, triangle_count, out_mesh, |p, n, t| {
+            let read = triples::<f64, DVec3>(p, "positions")?;
+            let bad = read.iter().enumerate().find_map(|(i, &v)| assemble::finite_position(v).err().map(|m| (i, m)));
+            if let Some((i, message)) = bad {
+                return Err(crate::Error::input(format!("vertex {i} {message}")).into());
+            }
+            Ok(assemble::mesh(read, n, t))
+        })
+    })
+}
+
+/// What vstree_mesh_create() and vstree_mesh_create_f64() share: the counts, the caller's
+/// arrays and the mesh's checks. `make` turns the borrowed positions, normals and triangles
+/// into the mesh; the new handle goes to `*out_mesh`.
+///
+/// # Safety
+/// The arrays hold the lengths the counts give (see vstree_mesh_create()).
+#[allow(clippy::too_many_arguments)]
+unsafe fn create<T>(
+    positions: *const T,
+    vertex_count: usize,
+    normals: *const f32,
+    triangles: *const u32,
+    triangle_count: usize,
+    out_mesh: *mut *mut vstree_mesh,
+    make: impl FnOnce(&[T], Option<Vec<Vec3>>, Vec<[u32; 3]>) -> FfiResult<Mesh>,
+) -> FfiResult {
+    non_null(out_mesh, "out_mesh")?;
+    let floats = elements(vertex_count, 3, "vertex_count")?;
+    let indices = elements(triangle_count, 3, "triangle_count")?;
+    if vertex_count == 0 {
+        return Err(Failure::new(vstree_status::InvalidInput, "`vertex_count` is 0: a mesh needs at least one vertex"));
+    }
+    // SAFETY (all three): the caller gives arrays of the documented lengths.
+    let positions = unsafe { input(positions, floats, "positions") }?;
+    let normals = match normals.is_null() {
+        true => None,
+        false => Some(unsafe { input(normals, floats, "normals") }?),
+    };
+    let triangles = unsafe { input(triangles, indices, "triangles") }?;
+    let mesh = make(
+        positions,
+        normals.map(|n| triples::<f32, Vec3>(n, "normals")).transpose()?,
+        triples::<u32, [u32; 3]>(triangles, "triangles")?,
+    )?;
+    mesh.check()?;
+    unsafe { write_out(out_mesh, into_handle(mesh)) };
+    Ok(())
 }
 
 /// A path from a C string: any bytes on Unix, UTF-8 elsewhere.

@@ -6,7 +6,7 @@
 //! element item such as `face 3` in binary PLY) and what is wrong. Writers replace the target
 //! file atomically: it is either left untouched or holds the complete new content.
 
-mod assemble;
+pub(crate) mod assemble;
 mod atomic;
 mod cleanup;
 mod input;

@@ -170,6 +170,36 @@ static void version_and_errors(void) {
   CHECK(vstree_mesh_vertex_count(NULL) == 0 && vstree_last_error_copy(NULL, 0) == n);
 }
 
+/* vstree_mesh_create_f64 keeps a model far from the origin (georeferenced, at 1e6 or 1e8)
+ * to within float rounding of its own size: the positions come back within 1e-6 of its
+ * extent, where float coordinates at 1e8 would be 8 apart. */
+static void far_mesh_creation(const torus *t) {
+  const double offsets[2] = {1e6, 1e8};
+  size_t n = 3 * t->vertex_count, i, k;
+  double *moved = malloc(n * sizeof *moved), *back = malloc(n * sizeof *back);
+  CHECK(moved != NULL && back != NULL);
+  for (k = 0; k < 2; k++) {
+    vstree_mesh *m = NULL;
+    double worst = 0.0;
+    for (i = 0; i < n; i++) moved[i] = (double)t->positions[i] + offsets[k];
+    EXPECT(VSTREE_STATUS_OK, NULL,
+           vstree_mesh_create_f64(moved, t->vertex_count, t->normals, t->triangles,
+                                  t->triangle_count, &m));
+    CHECK(m != NULL && vstree_mesh_triangle_count(m) == t->triangle_count &&
+          vstree_mesh_has_normals(m) == 1);
+    EXPECT(VSTREE_STATUS_OK, NULL, vstree_mesh_copy_positions_f64(m, back, n));
+    for (i = 0; i < n; i++) {
+      double d = fabs(back[i] - moved[i]);
+      if (d > worst) worst = d;
+    }
+    /* The torus is about 2.7 across. */
+    CHECK(worst < 2.7e-6);
+    vstree_mesh_free(m);
+  }
+  free(moved);
+  free(back);
+}
+
 static void mesh_creation(const torus *t) {
   float bad[12];
   uint32_t tri[3] = {0, 1, 2};
@@ -999,6 +1029,7 @@ int main(int argc, char **argv) {
 
   version_and_errors();
   mesh_creation(&t);
+  far_mesh_creation(&t);
   mesh_files(mesh);
   mesh_copies(mesh, cloud_no_normals);
   parameter_table(mesh);

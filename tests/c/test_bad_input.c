@@ -319,6 +319,83 @@ CALL(create_index_in_second_triangle) {
   return create(g_quad, 4, NULL, tris, 2);
 }
 
+/* vstree_mesh_create_f64: the same tetrahedron in doubles */
+static double g_quad_d[12];
+static vstree_status create_f64(const double *p, size_t n, const float *normals,
+                                const uint32_t *t, size_t m) {
+  vstree_mesh *out = (vstree_mesh *)SENTINEL;
+  vstree_status s = vstree_mesh_create_f64(p, n, normals, t, m, &out);
+  mesh_out(s, out);
+  return s;
+}
+static void reset_small_d(void) {
+  size_t k;
+  reset_small();
+  for (k = 0; k < 12; k++) g_quad_d[k] = g_quad[k];
+}
+CALL(create_f64_out_null) {
+  reset_small_d();
+  return vstree_mesh_create_f64(g_quad_d, 4, NULL, g_tri, 1, NULL);
+}
+CALL(create_f64_positions_null) { reset_small_d(); return create_f64(NULL, 4, NULL, g_tri, 1); }
+CALL(create_f64_triangles_null) { reset_small_d(); return create_f64(g_quad_d, 4, NULL, NULL, 1); }
+CALL(create_f64_zero_vertices) { reset_small_d(); return create_f64(g_quad_d, 0, NULL, g_tri, 0); }
+CALL(create_f64_vertices_above_u32) {
+  reset_small_d();
+  return create_f64(g_quad_d, (size_t)UINT32_MAX + 1u, NULL, g_tri, 1);
+}
+CALL(create_f64_vertices_times_3_overflows) {
+  reset_small_d();
+  return create_f64(g_quad_d, SIZE_MAX / 3 + 1, NULL, g_tri, 1);
+}
+CALL(create_f64_triangles_size_max) {
+  reset_small_d();
+  return create_f64(g_quad_d, 4, NULL, g_tri, SIZE_MAX);
+}
+CALL(create_f64_positions_aligned_to_4_only) {
+  reset_small_d();
+  return create_f64((const double *)(void *)((char *)g_quad_d + 4), 1, NULL, NULL, 0);
+}
+CALL(create_f64_normals_misaligned) {
+  reset_small_d();
+  return create_f64(g_quad_d, 1, (const float *)misaligned(g_floats), NULL, 0);
+}
+CALL(create_f64_position_nan) {
+  reset_small_d();
+  g_quad_d[4] = NAN;
+  return create_f64(g_quad_d, 4, NULL, g_tri, 1);
+}
+CALL(create_f64_position_minus_inf) {
+  reset_small_d();
+  g_quad_d[9] = -INFINITY;
+  return create_f64(g_quad_d, 4, NULL, NULL, 0);
+}
+CALL(create_f64_position_above_1e18) {
+  reset_small_d();
+  g_quad_d[6] = 2e18;
+  return create_f64(g_quad_d, 4, NULL, g_tri, 1);
+}
+CALL(create_f64_position_below_minus_1e18) {
+  reset_small_d();
+  g_quad_d[11] = -1e19;
+  return create_f64(g_quad_d, 4, NULL, NULL, 0);
+}
+CALL(create_f64_position_beyond_float) {
+  reset_small_d();
+  g_quad_d[0] = 1e300;
+  return create_f64(g_quad_d, 4, NULL, NULL, 0);
+}
+CALL(create_f64_normal_nan) {
+  reset_small_d();
+  g_quad_normals[11] = NAN;
+  return create_f64(g_quad_d, 4, g_quad_normals, g_tri, 1);
+}
+CALL(create_f64_index_equal_count) {
+  reset_small_d();
+  g_tri[2] = 4;
+  return create_f64(g_quad_d, 4, NULL, g_tri, 1);
+}
+
 /* vstree_mesh_load */
 CALL(load_out_null) { return vstree_mesh_load("x.ply", NULL); }
 CALL(load_path_null) {
@@ -1141,6 +1218,46 @@ static const bad_case g_cases[] = {
         "only 4 vertices"),
     ROW(create_index_in_second_triangle, INVALID_INPUT,
         "vstree_mesh_create: invalid input: triangle 1 uses vertex 1000, but there are only 4 "
+        "vertices"),
+    ROW(create_f64_out_null, NULL_POINTER, "vstree_mesh_create_f64: `out_mesh` is NULL"),
+    ROW(create_f64_positions_null, NULL_POINTER, "vstree_mesh_create_f64: `positions` is NULL"),
+    ROW(create_f64_triangles_null, NULL_POINTER, "vstree_mesh_create_f64: `triangles` is NULL"),
+    ROW(create_f64_zero_vertices, INVALID_INPUT,
+        "vstree_mesh_create_f64: `vertex_count` is 0: a mesh needs at least one vertex"),
+    ROW(create_f64_vertices_above_u32, TOO_LARGE,
+        "vstree_mesh_create_f64: `vertex_count` is 4294967296, more than the limit of "
+        "4294967295"),
+    ROW(create_f64_vertices_times_3_overflows, TOO_LARGE,
+        "vstree_mesh_create_f64: `vertex_count` is 6148914691236517206, more than the limit of "
+        "4294967295"),
+    ROW(create_f64_triangles_size_max, TOO_LARGE,
+        "vstree_mesh_create_f64: `triangle_count` is 18446744073709551615, more than the limit "
+        "of 4294967295"),
+    ROW(create_f64_positions_aligned_to_4_only, INVALID_ARGUMENT,
+        "vstree_mesh_create_f64: `positions`: 0x* is not aligned to 8 bytes as its element type "
+        "requires"),
+    ROW(create_f64_normals_misaligned, INVALID_ARGUMENT,
+        "vstree_mesh_create_f64: `normals`: 0x* is not aligned to 4 bytes as its element type "
+        "requires"),
+    ROW(create_f64_position_nan, INVALID_INPUT,
+        "vstree_mesh_create_f64: invalid input: vertex 1 has a NaN or infinite coordinate (1, "
+        "NaN, 0)"),
+    ROW(create_f64_position_minus_inf, INVALID_INPUT,
+        "vstree_mesh_create_f64: invalid input: vertex 3 has a NaN or infinite coordinate (-inf, "
+        "0, 1)"),
+    ROW(create_f64_position_above_1e18, INVALID_INPUT,
+        "vstree_mesh_create_f64: invalid input: vertex 2 has a coordinate of 2e18: at most 1e18 "
+        "in magnitude is supported (32-bit geometry); rescale the input"),
+    ROW(create_f64_position_below_minus_1e18, INVALID_INPUT,
+        "vstree_mesh_create_f64: invalid input: vertex 3 has a coordinate of 1e19: at most 1e18 "
+        "in magnitude is supported (32-bit geometry); rescale the input"),
+    ROW(create_f64_position_beyond_float, INVALID_INPUT,
+        "vstree_mesh_create_f64: invalid input: vertex 0 has a coordinate of 1e300: at most "
+        "1e18 in magnitude is supported (32-bit geometry); rescale the input"),
+    ROW(create_f64_normal_nan, INVALID_INPUT,
+        "vstree_mesh_create_f64: invalid input: normal 3 has a NaN or infinite component"),
+    ROW(create_f64_index_equal_count, INVALID_INPUT,
+        "vstree_mesh_create_f64: invalid input: triangle 0 uses vertex 4, but there are only 4 "
         "vertices"),
 
     ROW(load_out_null, NULL_POINTER, "vstree_mesh_load: `out_mesh` is NULL"),

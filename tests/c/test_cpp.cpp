@@ -3,6 +3,7 @@
 // thrown inside a progress callback comes out of the call unchanged.
 #include <vstree.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -108,6 +109,19 @@ int main(int argc, char **argv) {
   CHECK(owned.get() == nullptr && moved.get() != nullptr);
   moved = vstree::mesh::create({0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2});
   CHECK(moved.vertex_count() == 3);
+
+  // Doubles far from the origin keep their detail: the unit sphere at 1e8 comes back within
+  // float rounding of its own size, where float coordinates there are 8 apart.
+  {
+    std::vector<double> far(p.begin(), p.end());
+    for (double &x : far) x += 1e8;
+    vstree::mesh f = vstree::mesh::create_f64(far, t);
+    std::vector<double> back = f.positions_f64();
+    double worst = 0.0;
+    CHECK(back.size() == far.size() && f.triangles() == t);
+    for (std::size_t i = 0; i < back.size(); i++) worst = std::max(worst, std::fabs(back[i] - far[i]));
+    CHECK(worst < 2e-6);
+  }
 
   // Errors carry the status and the library's message.
   expect_error(VSTREE_STATUS_INVALID_PARAMETER, "`d_a`", [&] {

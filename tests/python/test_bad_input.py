@@ -5,8 +5,10 @@ What the library says is pinned as it is today: a change of wording fails here o
 
 ``{tmp}`` in a message stands for the test's tmp_path."""
 
+import copy
 import os
 import pathlib
+import pickle
 
 import numpy as np
 import pytest
@@ -159,6 +161,47 @@ CLOSED_CASES = [
     case("closed-tree-t-nodes", lambda c: c.closed_tree().t_nodes, ValueError, None, TREE_CLOSED),
     case("closed-tree-levels", lambda c: c.closed_tree().levels, ValueError, None, TREE_CLOSED),
     case("closed-tree-vertex-labels", lambda c: c.closed_tree().vertex_labels("t_node"), ValueError, None, TREE_CLOSED),
+    case("copy-closed-mesh", lambda c: copy.copy(c.closed_mesh()), ValueError, None, MESH_CLOSED),
+    case("pickle-closed-mesh", lambda c: pickle.dumps(c.closed_mesh()), ValueError, None, MESH_CLOSED),
+]
+
+
+# ---- copies of what cannot be copied, and closing what a running call uses --------------------
+
+TREE_NOT_COPIED = (
+    "vstree.Tree cannot be copied or pickled: it owns a tree in the library, which a copy would share and free "
+    "twice, and a pickle would store only its address; build another with vstree.Tree(mesh, **params), or copy "
+    "or pickle its arrays (stats, nodes, t_nodes, levels, vertex_labels()), which are plain Python and numpy "
+    "objects"
+)
+IN_USE = (
+    "Mesh.close: the mesh is in use by %s, which is still running (close() was called from its progress "
+    "callback or from another thread); the library reads it, so it cannot be freed now: close it after the "
+    "call returns"
+)
+
+
+def close_in_callback(call):
+    """``call(mesh, progress)`` with a callback that closes the mesh the call is using."""
+
+    def run(c):
+        mesh = vstree.Mesh(CLOUD, None, CLOUD) if call is not vstree.estimate_normals else vstree.Mesh(CLOUD)
+        return call(mesh, progress=lambda fraction, stage: mesh.close())
+
+    return run
+
+
+IN_USE_CASES = [
+    case("copy-tree", lambda c: copy.copy(vstree.Tree(c.mesh())), TypeError, None, TREE_NOT_COPIED),
+    case("deepcopy-tree", lambda c: copy.deepcopy(vstree.Tree(c.mesh())), TypeError, None, TREE_NOT_COPIED),
+    case("pickle-tree", lambda c: pickle.dumps(vstree.Tree(c.mesh())), TypeError, None, TREE_NOT_COPIED),
+    case("simplify-closes-its-mesh", close_in_callback(vstree.simplify), RuntimeError, None,
+         IN_USE % "vstree.simplify"),
+    case("tree-closes-its-mesh", close_in_callback(vstree.Tree), RuntimeError, None, IN_USE % "vstree.Tree"),
+    case("reconstruct-closes-its-mesh", close_in_callback(vstree.reconstruct), RuntimeError, None,
+         IN_USE % "vstree.reconstruct"),
+    case("estimate-normals-closes-its-mesh", close_in_callback(vstree.estimate_normals), RuntimeError, None,
+         IN_USE % "vstree.estimate_normals"),
 ]
 
 
@@ -400,9 +443,9 @@ ARRAY_CASES = [
     case("positions-objects", mesh_of([[0, 0, {}]]), TypeError, None,
          "positions: float() argument must be a string or a real number, not 'dict'"),
     case("positions-empty", mesh_of(np.zeros((0, 3))), vstree.VstreeError, INPUT,
-         "vstree_mesh_create: `vertex_count` is 0: a mesh needs at least one vertex"),
+         "vstree_mesh_create_f64: `vertex_count` is 0: a mesh needs at least one vertex"),
     case("positions-empty-list", mesh_of([]), vstree.VstreeError, INPUT,
-         "vstree_mesh_create: `vertex_count` is 0: a mesh needs at least one vertex"),
+         "vstree_mesh_create_f64: `vertex_count` is 0: a mesh needs at least one vertex"),
     case("positions-nan", mesh_of(with_item(P, (5, 1), np.nan), T), vstree.VstreeError, INPUT,
          "vstree_mesh_create: invalid input: vertex 5 has a NaN or infinite coordinate"),
     case("positions-inf", mesh_of(with_item(P, (7, 0), np.inf), T), vstree.VstreeError, INPUT,
@@ -414,8 +457,14 @@ ARRAY_CASES = [
          "magnitude is supported (32-bit geometry); rescale the input"),
     case("positions-float64-beyond-float32", mesh_of(with_item(P.astype(np.float64), (12, 2), -1e300), T),
          vstree.VstreeError, INPUT,
-         "vstree.Mesh: invalid input: vertex 12 has a coordinate of -1e+300: at most 1e18 in "
+         "vstree_mesh_create_f64: invalid input: vertex 12 has a coordinate of 1e300: at most 1e18 in "
          "magnitude is supported (32-bit geometry); rescale the input"),
+    case("positions-float64-nan", mesh_of(with_item(P.astype(np.float64) + 1e6, (5, 1), np.nan), T),
+         vstree.VstreeError, INPUT, "vstree_mesh_create_f64: invalid input: vertex 5 has a NaN or infinite "
+         "coordinate (1000000.7878679633, NaN, 999999.7878679633)"),
+    case("positions-float64-beyond-1e18", mesh_of(with_item(P.astype(np.float64), (11, 0), -2e18), T),
+         vstree.VstreeError, INPUT, "vstree_mesh_create_f64: invalid input: vertex 11 has a coordinate of 2e18: "
+         "at most 1e18 in magnitude is supported (32-bit geometry); rescale the input"),
     case("triangles-negative", mesh_of(P, T.astype(np.int64) - 1), ValueError, None,
          "triangle 0 uses vertex -1: indices must be in [0, 2^32 - 1]"),
     case("triangles-beyond-uint32", mesh_of(P, with_item(T.astype(np.int64), (3, 2), 2**33)), ValueError, None,
@@ -447,7 +496,7 @@ ARRAY_CASES = [
     case("reconstruct-mesh-and-normals", lambda c: vstree.reconstruct(vstree.Mesh(CLOUD), CLOUD), ValueError, None,
          "normals are given with the Mesh, not separately"),
     case("reconstruct-no-points", lambda c: vstree.reconstruct(np.zeros((0, 3))), vstree.VstreeError, INPUT,
-         "vstree_mesh_create: `vertex_count` is 0: a mesh needs at least one vertex"),
+         "vstree_mesh_create_f64: `vertex_count` is 0: a mesh needs at least one vertex"),
     case("reconstruct-five-points", lambda c: vstree.reconstruct(CLOUD[:5]), vstree.VstreeError, INPUT,
          "vstree_reconstruct: invalid input: 5 points: at least 10 are needed"),
     case("reconstruct-points-on-a-line", lambda c: vstree.reconstruct(LINE), vstree.VstreeError, INPUT,
@@ -644,7 +693,7 @@ FILE_CASES = [
          ("vstree_mesh_save: {tmp}/out.ply: ", "directory"), False),
 ]
 
-CASES = NUL_CASES + CLOSED_CASES + PARAMETER_CASES + ARRAY_CASES + TYPE_CASES + FILE_CASES
+CASES = NUL_CASES + CLOSED_CASES + IN_USE_CASES + PARAMETER_CASES + ARRAY_CASES + TYPE_CASES + FILE_CASES
 
 
 @pytest.mark.parametrize("call, exc, status, message, exact", CASES)

@@ -2,7 +2,9 @@
 status and message, progress that cancels, exceptions through callbacks, the tree for viewers,
 threads, library lookup and the ABI check."""
 
+import copy
 import os
+import pickle
 import re
 import subprocess
 import sys
@@ -466,3 +468,216 @@ def test_a_model_far_from_the_origin_keeps_its_detail(tmp_path):
     assert simplified.vertex_count == reference.vertex_count
     # The same clusters (at 1e8 in float32 alone they would be 4 units off).
     np.testing.assert_allclose(simplified.positions_f64 - 1e8, reference.positions_f64, rtol=0, atol=1e-5)
+
+
+# ---- float64 input ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("offset", [1e6, 1e7, 1e8])
+def test_float64_positions_far_from_the_origin_are_kept_as_a_file_keeps_them(offset):
+    # A unit sphere 1e6 to 1e8 away: float32 coordinates there are 1/16 to 8 apart, so it came
+    # back with radius errors of 0.24 at 1e6 and as one point at 1e7 and beyond.
+    sphere = fibonacci_sphere(3000).astype(np.float64)
+    far = sphere + offset
+    mesh = vstree.Mesh(far, None, sphere)
+    # The readers' rule: relative to the box's centre rounded to float32, in float32.
+    origin = ((far.min(0) + far.max(0)) / 2).astype(np.float32).astype(np.float64)
+    expected = (far - origin).astype(np.float32).astype(np.float64) + origin
+    np.testing.assert_array_equal(mesh.positions_f64, expected)
+    radius_error = np.abs(np.linalg.norm(mesh.positions_f64 - offset, axis=1) - 1).max()
+    assert radius_error < 1e-6, radius_error
+    # float32 input keeps the float32 path: stored as given.
+    as_float32 = far.astype(np.float32)
+    np.testing.assert_array_equal(vstree.Mesh(as_float32).positions_f64, as_float32.astype(np.float64))
+
+
+# ---- copies and pickles ----------------------------------------------------------------------
+
+
+def _same_mesh(a, b):
+    np.testing.assert_array_equal(a.positions_f64, b.positions_f64)
+    np.testing.assert_array_equal(a.triangles, b.triangles)
+    if a.normals is None:
+        assert b.normals is None
+    else:
+        np.testing.assert_array_equal(a.normals, b.normals)
+
+
+COPIES = {
+    "copy": copy.copy,
+    "deepcopy": copy.deepcopy,
+    "pickle": lambda m: pickle.loads(pickle.dumps(m)),
+}
+
+
+@pytest.mark.parametrize("how", sorted(COPIES))
+def test_a_copied_or_pickled_mesh_is_an_independent_equal_mesh(shape, how):
+    mesh = vstree.Mesh(*shape)
+    p, t, n = torus(16, 8)
+    far = vstree.Mesh(p.astype(np.float64) + np.array([1e6, -3e7, 1e8]), t, n)
+    for original in (mesh, far, vstree.Mesh(p), vstree.Mesh(p, None, n)):
+        copied = COPIES[how](original)
+        assert copied is not original and copied._handle != original._handle
+        _same_mesh(copied, original)  # exact, far from the origin too
+    source = vstree.Mesh(p, t)
+    copied = COPIES[how](source)
+    source.close()
+    assert copied.vertex_count == len(p)  # its own handle: closing the original leaves it
+    with pytest.raises(ValueError, match="^the mesh was closed$"):
+        COPIES[how](source)
+
+
+TREE_REFUSED = (
+    "vstree.Tree cannot be copied or pickled: it owns a tree in the library, which a copy would share and "
+    "free twice, and a pickle would store only its address; build another with vstree.Tree(mesh, **params), "
+    "or copy or pickle its arrays (stats, nodes, t_nodes, levels, vertex_labels()), which are plain Python and "
+    "numpy objects"
+)
+
+
+@pytest.mark.parametrize("how", sorted(COPIES))
+def test_a_tree_refuses_to_be_copied_or_pickled(shape, how):
+    with vstree.Tree(vstree.Mesh(*shape)) as tree:
+        with pytest.raises(TypeError) as e:
+            COPIES[how](tree)
+        assert str(e.value) == TREE_REFUSED
+        assert tree.nodes.size > 0
+
+
+COPY_THEN_DELETE = """
+import copy, gc, pickle
+import vstree
+from test_vstree import torus
+p, t, n = torus(16, 8)
+mesh = vstree.Mesh(p, t, n)
+tree = vstree.Tree(mesh)
+copies = [copy.copy(mesh), copy.deepcopy(mesh), pickle.loads(pickle.dumps(mesh))]
+for how in (copy.copy, copy.deepcopy, pickle.dumps):
+    try:
+        copies.append(how(tree))
+    except TypeError:
+        pass
+del mesh, tree, copies
+gc.collect()
+print("all freed once")
+"""
+
+
+def test_copies_then_deleting_everything_does_not_crash():
+    # Copies that shared the handle freed it twice: a segmentation fault (so in a subprocess).
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([os.path.join(ROOT, "bindings", "python"), os.path.join(ROOT, "tests", "python")])
+    run = subprocess.run([sys.executable, "-c", COPY_THEN_DELETE], env=env, capture_output=True, text=True, timeout=120)
+    assert (run.returncode, run.stdout, run.stderr) == (0, "all freed once\n", "")
+
+
+# ---- closing what a running call uses ----------------------------------------------------------
+
+IN_USE = (
+    "Mesh.close: the mesh is in use by %s, which is still running (close() was called from its progress "
+    "callback or from another thread); the library reads it, so it cannot be freed now: close it after the "
+    "call returns"
+)
+CALLS_WITH_PROGRESS = {
+    "vstree.simplify": lambda mesh, progress: vstree.simplify(mesh, progress=progress),
+    "vstree.Tree": lambda mesh, progress: vstree.Tree(mesh, progress=progress),
+    "vstree.reconstruct": lambda mesh, progress: vstree.reconstruct(mesh, progress=progress, max_levels=1),
+    "vstree.estimate_normals": lambda mesh, progress: vstree.estimate_normals(mesh, progress=progress),
+}
+
+
+@pytest.mark.parametrize("who", sorted(CALLS_WITH_PROGRESS))
+def test_closing_the_mesh_from_the_progress_callback_is_refused(who):
+    # The library went on reading the freed mesh (valgrind: hundreds of invalid reads).
+    points = fibonacci_sphere(2000)
+    mesh = vstree.Mesh(points, None, None if who == "vstree.estimate_normals" else points)
+    refused = []
+
+    def progress(fraction, stage):
+        try:
+            mesh.close()
+        except RuntimeError as e:
+            refused.append(str(e))
+        return True
+
+    CALLS_WITH_PROGRESS[who](mesh, progress)
+    assert refused and set(refused) == {IN_USE % who}
+    np.testing.assert_array_equal(mesh.positions, points)  # still open, and whole
+    mesh.close()
+    with pytest.raises(ValueError, match="^the mesh was closed$"):
+        mesh.vertex_count
+
+
+def test_closing_the_mesh_from_the_callback_cancels_when_the_error_is_not_caught(shape):
+    mesh = vstree.Mesh(*shape)
+    with pytest.raises(RuntimeError) as e:
+        vstree.simplify(mesh, progress=lambda fraction, stage: mesh.close())
+    assert str(e.value) == IN_USE % "vstree.simplify"
+    assert vstree.simplify(mesh).mesh.vertex_count > 0
+
+
+def test_closing_the_mesh_from_another_thread_during_a_call_is_refused(shape):
+    # ctypes releases the GIL during the call: another thread runs meanwhile. The callback
+    # holds the call at its first report while this thread tries to close the mesh.
+    mesh = vstree.Mesh(*shape)
+    inside, release, results = threading.Event(), threading.Event(), []
+
+    def progress(fraction, stage):
+        inside.set()
+        return release.wait(60)
+
+    worker = threading.Thread(target=lambda: results.append(vstree.simplify(mesh, progress=progress)))
+    worker.start()
+    try:
+        assert inside.wait(60)
+        with pytest.raises(RuntimeError) as e:
+            mesh.close()
+        assert str(e.value) == IN_USE % "vstree.simplify"
+    finally:
+        release.set()
+        worker.join(60)
+    assert results[0].mesh.vertex_count > 0
+    mesh.close()
+
+
+def test_closing_a_tree_or_mesh_while_a_call_holds_it_is_refused(shape):
+    # Queries and saves have no callback; what holds them is the same use count.
+    mesh = vstree.Mesh(*shape)
+    tree = vstree.Tree(mesh)
+    for thing, who in [(tree, "Tree.nodes"), (mesh, "Mesh.save")]:
+        with thing._use(who):
+            with pytest.raises(RuntimeError, match="in use by %s, which is still running" % who):
+                thing.close()
+        thing.close()
+        thing.close()
+
+
+def test_threads_reading_a_mesh_while_another_closes_it_see_it_whole_or_closed(shape):
+    for _ in range(20):
+        mesh = vstree.Mesh(*shape)
+        seen, start = [], threading.Barrier(5)
+
+        def read():
+            start.wait()
+            for _ in range(50):
+                try:
+                    seen.append(mesh.positions.shape)
+                except (ValueError, RuntimeError):
+                    pass
+
+        def close():
+            start.wait()
+            while True:
+                try:
+                    return mesh.close()
+                except RuntimeError:  # a reader holds it: try again
+                    pass
+
+        threads = [threading.Thread(target=read) for _ in range(4)] + [threading.Thread(target=close)]
+        for th in threads:
+            th.start()
+        for th in threads:
+            th.join()
+        assert set(seen) <= {shape[0].shape}
+        with pytest.raises(ValueError):
+            mesh.positions

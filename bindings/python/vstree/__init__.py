@@ -17,13 +17,17 @@ the binding can judge before calling C raise TypeError or ValueError naming the 
 the argument (a path with a NUL byte, a closed Mesh or Tree, a float where an integer is
 needed, an unknown enum name), as do arrays numpy cannot convert. Depends on
 numpy and the standard library only (Blender's Python has both). The calls release the GIL,
-so threads can simplify different meshes at once.
+so threads can simplify different meshes at once. Closing a Mesh or Tree while a call uses it
+(from the call's progress callback, or from another thread) raises RuntimeError and leaves
+it open: close it after the call returns.
 """
 
+import contextlib
 import ctypes
 import numbers
 import operator
 import os
+import threading
 from collections import namedtuple
 
 import numpy as np
@@ -108,26 +112,121 @@ def _path(path):
     return _c_string(path, "path")
 
 
-class Mesh:
+class _Owner:
+    """What :class:`Mesh` and :class:`Tree` share: the library handle each owns, freed by
+    close() or when the object is garbage-collected. A copy that shared the handle would free
+    it twice, and pickle would store a pointer into this process: copy.copy(),
+    copy.deepcopy() and pickle refuse with TypeError unless the class makes a new handle from
+    its data (Mesh does).
+
+    Every call that gives the handle to the library holds it through :meth:`_use`, which
+    counts the calls running with it (under a lock: the calls release the GIL, so other
+    threads run meanwhile, and a progress callback runs Python code in the middle of one).
+    close() refuses while that count is not zero, instead of freeing what the library reads."""
+
+    __slots__ = ("_handle", "_lock", "_users")
+    #: The object's name in messages ("mesh"), and what to do instead of copying it.
+    _what = "object"
+    _instead = ""
+
+    def _own(self, handle):
+        self._lock = threading.Lock()
+        self._users = []  # the names of the calls running with the handle
+        self._handle = handle
+
+    def _free(self, handle):
+        raise NotImplementedError
+
+    @contextlib.contextmanager
+    def _use(self, who):
+        """The handle, held for the call ``who`` until the block ends; a closed object has
+        none (C would report a NULL pointer instead of saying why)."""
+        lock = getattr(self, "_lock", None)
+        if lock is None:  # made by a constructor that failed
+            raise ValueError("the %s was closed" % self._what)
+        with lock:
+            if not self._handle:
+                raise ValueError("the %s was closed" % self._what)
+            self._users.append(who)
+        try:
+            yield self._handle
+        finally:
+            with lock:
+                self._users.remove(who)
+
+    def close(self):
+        """Frees the library's object now (it is freed when garbage-collected otherwise);
+        closing twice is harmless. While a call uses the object (close() called from the
+        call's progress callback, or from another thread: the calls release the GIL), it is
+        refused with RuntimeError, and the object stays usable: the library is reading it, and
+        a close deferred until the call returns would break close()'s promise that the memory
+        is free when it returns. Close it after the call returns."""
+        lock = getattr(self, "_lock", None)
+        if lock is None:
+            return
+        with lock:
+            if self._users:
+                raise RuntimeError(
+                    "%s.close: the %s is in use by %s, which is still running (close() was called from its "
+                    "progress callback or from another thread); the library reads it, so it cannot be freed "
+                    "now: close it after the call returns" % (type(self).__name__, self._what, self._users[0])
+                )
+            handle, self._handle = self._handle, None
+        if handle:
+            self._free(handle)
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # interpreter shutdown: the library may already be unloaded
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __reduce__(self):
+        name = type(self).__name__
+        raise TypeError(
+            "vstree.%s cannot be copied or pickled: it owns a %s in the library, which a copy would "
+            "share and free twice, and a pickle would store only its address; %s" % (name, self._what, self._instead)
+        )
+
+
+class Mesh(_Owner):
     """A triangle mesh, or a point cloud when it has no triangles; immutable.
 
     ``positions``: (n, 3) array-like of floats; ``triangles``: (m, 3) array-like of vertex
     indices (None or empty for a point cloud); ``normals``: None or (n, 3) floats. The arrays
     are copied into the library.
+
+    float32 positions are used as they are. Any others (float64, integers, lists) are read in
+    double precision and kept as a file's are: a model far from the origin for its size
+    (georeferenced coordinates at 1e6 or 1e8) is stored relative to its own centre, so its
+    detail survives and :attr:`positions_f64` gives it back.
+
+    copy.copy(), copy.deepcopy() and pickle make an independent mesh from its arrays
+    (positions in float64, so a model far from the origin is copied exactly).
     """
 
-    __slots__ = ("_handle",)
+    __slots__ = ()
+    _what = "mesh"
 
     def __init__(self, positions, triangles=None, normals=None):
-        p = _as_rows(positions, np.float32, "positions")
+        p = _as_rows(positions, None, "positions")
         n = None if normals is None else _as_rows(normals, np.float32, "normals")
         if n is not None and n.shape != p.shape:
             raise ValueError("normals has shape %s, positions %s" % (n.shape, p.shape))
         t = np.zeros((0, 3), np.uint32) if triangles is None else _as_indices(triangles)
+        create, pointer = (
+            (lib.vstree_mesh_create, _ffi._F32P) if p.dtype == np.float32 else (lib.vstree_mesh_create_f64, _ffi._F64P)
+        )
         handle = ctypes.c_void_p()
         _check(
-            lib.vstree_mesh_create(
-                p.ctypes.data_as(_ffi._F32P),
+            create(
+                p.ctypes.data_as(pointer),
                 p.shape[0],
                 None if n is None else n.ctypes.data_as(_ffi._F32P),
                 t.ctypes.data_as(_ffi._U32P),
@@ -135,13 +234,20 @@ class Mesh:
                 ctypes.byref(handle),
             )
         )
-        self._handle = handle.value
+        self._own(handle.value)
 
     @classmethod
     def _wrap(cls, handle):
         mesh = cls.__new__(cls)
-        mesh._handle = handle
+        mesh._own(handle)
         return mesh
+
+    def _free(self, handle):
+        lib.vstree_mesh_free(handle)
+
+    def __reduce__(self):
+        """A new mesh from this one's arrays: what copy and pickle use."""
+        return (Mesh, (self.positions_f64, self.triangles, self.normals))
 
     @classmethod
     def load(cls, path):
@@ -166,75 +272,58 @@ class Mesh:
 
     def save(self, path, ascii=False):
         """Writes the mesh (format from the extension; atomic: on error the file is unchanged)."""
-        _check(lib.vstree_mesh_save(self._live(), _path(path), 1 if ascii else 0))
-
-    def close(self):
-        """Frees the mesh now (it is freed when garbage-collected otherwise)."""
-        handle, self._handle = getattr(self, "_handle", None), None
-        if handle:
-            lib.vstree_mesh_free(handle)
-
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown: the library may already be unloaded
-            pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def _live(self):
-        """The handle, for every call that uses it; a closed mesh has none (C would report a
-        NULL pointer instead of saying why)."""
-        handle = getattr(self, "_handle", None)
-        if not handle:
-            raise ValueError("the mesh was closed")
-        return handle
+        path = _path(path)
+        with self._use("Mesh.save") as handle:
+            _check(lib.vstree_mesh_save(handle, path, 1 if ascii else 0))
 
     @property
     def vertex_count(self):
-        return lib.vstree_mesh_vertex_count(self._live())
+        with self._use("Mesh.vertex_count") as handle:
+            return lib.vstree_mesh_vertex_count(handle)
 
     @property
     def triangle_count(self):
-        return lib.vstree_mesh_triangle_count(self._live())
+        with self._use("Mesh.triangle_count") as handle:
+            return lib.vstree_mesh_triangle_count(handle)
 
     @property
     def has_normals(self):
-        return lib.vstree_mesh_has_normals(self._live()) == 1
+        with self._use("Mesh.has_normals") as handle:
+            return lib.vstree_mesh_has_normals(handle) == 1
 
     @property
     def positions(self):
         """(n, 3) float32 array (a copy)."""
-        out = np.empty((self.vertex_count, 3), np.float32)
-        _check(lib.vstree_mesh_copy_positions(self._live(), out.ctypes.data_as(_ffi._F32P), out.size))
+        with self._use("Mesh.positions") as handle:
+            out = np.empty((lib.vstree_mesh_vertex_count(handle), 3), np.float32)
+            _check(lib.vstree_mesh_copy_positions(handle, out.ctypes.data_as(_ffi._F32P), out.size))
         return out
 
     @property
     def positions_f64(self):
         """(n, 3) float64 array (a copy): the exact positions of a model read from a file far
         from the origin (georeferenced coordinates), which float32 would round."""
-        out = np.empty((self.vertex_count, 3), np.float64)
-        _check(lib.vstree_mesh_copy_positions_f64(self._live(), out.ctypes.data_as(_ffi._F64P), out.size))
+        with self._use("Mesh.positions_f64") as handle:
+            out = np.empty((lib.vstree_mesh_vertex_count(handle), 3), np.float64)
+            _check(lib.vstree_mesh_copy_positions_f64(handle, out.ctypes.data_as(_ffi._F64P), out.size))
         return out
 
     @property
     def normals(self):
         """(n, 3) float32 array (a copy), or None when the mesh has none."""
-        if not self.has_normals:
-            return None
-        out = np.empty((self.vertex_count, 3), np.float32)
-        _check(lib.vstree_mesh_copy_normals(self._live(), out.ctypes.data_as(_ffi._F32P), out.size))
+        with self._use("Mesh.normals") as handle:
+            if lib.vstree_mesh_has_normals(handle) != 1:
+                return None
+            out = np.empty((lib.vstree_mesh_vertex_count(handle), 3), np.float32)
+            _check(lib.vstree_mesh_copy_normals(handle, out.ctypes.data_as(_ffi._F32P), out.size))
         return out
 
     @property
     def triangles(self):
         """(m, 3) uint32 array of vertex indices (a copy)."""
-        out = np.empty((self.triangle_count, 3), np.uint32)
-        _check(lib.vstree_mesh_copy_triangles(self._live(), out.ctypes.data_as(_ffi._U32P), out.size))
+        with self._use("Mesh.triangles") as handle:
+            out = np.empty((lib.vstree_mesh_triangle_count(handle), 3), np.uint32)
+            _check(lib.vstree_mesh_copy_triangles(handle, out.ctypes.data_as(_ffi._U32P), out.size))
         return out
 
     def __repr__(self):
@@ -252,14 +341,15 @@ def load(path):
     return Mesh.load(path)
 
 
-def _mesh_handle(who, mesh):
-    """The live handle of ``mesh``, which must be a :class:`Mesh` (not an array)."""
+def _using(who, mesh):
+    """The handle of ``mesh``, which must be a :class:`Mesh` (not an array), held for the call
+    ``who`` (see ``_Owner._use``)."""
     if not isinstance(mesh, Mesh):
         raise TypeError(
             "%s: `mesh` must be a vstree.Mesh, not %s (make one with vstree.Mesh(positions, triangles))"
             % (who, type(mesh).__name__)
         )
-    return mesh._live()
+    return mesh._use(who)
 
 
 def _rows(a, array, name):
@@ -272,13 +362,16 @@ def _rows(a, array, name):
 
 
 def _as_rows(array, dtype, name):
-    """(n, 3) float32 rows of ``positions`` or ``normals``. Refused here, with the array's name:
-    None, strings, complex numbers (numpy would drop the imaginary part), objects that do not
-    convert, and finite values too large for float32 (the library would see infinities)."""
+    """(n, 3) rows of ``positions`` or ``normals`` in ``dtype``; None for positions: float32
+    stays float32, anything else becomes float64. Refused here, with the array's name: None,
+    strings, complex numbers (numpy would drop the imaginary part), objects that do not
+    convert, and finite values too large for ``dtype`` (the library would see infinities)."""
     if array is None:
         raise TypeError("%s must be an (n, 3) array of numbers, not None" % name)
     try:  # ragged lists, objects that are not numbers: numpy's reason, with the array's name
         source = np.asarray(array)
+        if dtype is None:
+            dtype = np.float32 if source.dtype == np.float32 else np.float64
         if source.dtype.kind not in "USc":
             with np.errstate(over="ignore"):  # overflow is reported below, with the vertex
                 a = np.ascontiguousarray(source, dtype=dtype)
@@ -489,13 +582,13 @@ def simplify(mesh, progress=None, ratio=None, **params):
     ``progress(fraction, stage)`` is called on this thread; returning False cancels
     (:class:`CancelledError`). Returns ``SimplifyResult(mesh, stats)``.
     """
-    handle = _mesh_handle("vstree.simplify", mesh)
-    if ratio is not None:
-        params["target_faces"] = _target_from_ratio(ratio, params, lib.vstree_mesh_triangle_count(handle))
-    p = _params("vstree.simplify", params)
-    cb = _Progress("vstree.simplify", progress)
-    result = ctypes.c_void_p()
-    cb.check(lib.vstree_simplify(handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
+    with _using("vstree.simplify", mesh) as handle:
+        if ratio is not None:
+            params["target_faces"] = _target_from_ratio(ratio, params, lib.vstree_mesh_triangle_count(handle))
+        p = _params("vstree.simplify", params)
+        cb = _Progress("vstree.simplify", progress)
+        result = ctypes.c_void_p()
+        cb.check(lib.vstree_simplify(handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
     try:
         stats = lib.vstree_simplify_result_get_stats(result).contents
         if stats.struct_size < ctypes.sizeof(_ffi.SimplifyStats):
@@ -509,67 +602,55 @@ def simplify(mesh, progress=None, ratio=None, **params):
     return SimplifyResult(Mesh._wrap(out.value), stats)
 
 
-class Tree:
+class Tree(_Owner):
     """The tree :func:`simplify` would cluster ``mesh`` with (same parameters), for viewers:
     ``stats`` (dict), ``nodes``, ``t_nodes`` (the T-layer with frames), ``levels`` (node
-    counts per depth) as numpy structured arrays, and :meth:`vertex_labels`."""
+    counts per depth) as numpy structured arrays, and :meth:`vertex_labels`.
+
+    A tree cannot be copied or pickled (TypeError): the library has no copy of it and it does
+    not keep its mesh; build another, or copy its arrays, which are numpy arrays."""
 
     NO_INDEX = 0xFFFFFFFF
+    _what = "tree"
+    _instead = (
+        "build another with vstree.Tree(mesh, **params), or copy or pickle its arrays (stats, nodes, "
+        "t_nodes, levels, vertex_labels()), which are plain Python and numpy objects"
+    )
 
     def __init__(self, mesh, progress=None, **params):
         p = _params("vstree.Tree", params)
-        mesh_handle = _mesh_handle("vstree.Tree", mesh)
-        cb = _Progress("vstree.Tree", progress)
-        handle = ctypes.c_void_p()
-        cb.check(lib.vstree_tree_build(mesh_handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(handle)))
-        self._handle = handle.value
-        self.stats = _struct_dict(lib.vstree_tree_get_stats(self._handle).contents)
+        with _using("vstree.Tree", mesh) as mesh_handle:
+            cb = _Progress("vstree.Tree", progress)
+            handle = ctypes.c_void_p()
+            cb.check(lib.vstree_tree_build(mesh_handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(handle)))
+        self._own(handle.value)
+        self.stats = _struct_dict(lib.vstree_tree_get_stats(handle.value).contents)
 
-    def close(self):
-        handle, self._handle = getattr(self, "_handle", None), None
-        if handle:
-            lib.vstree_tree_free(handle)
+    def _free(self, handle):
+        lib.vstree_tree_free(handle)
 
-    def __del__(self):
-        try:
-            self.close()
-        except Exception:  # interpreter shutdown: the library may already be unloaded
-            pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def _live(self):
-        handle = getattr(self, "_handle", None)
-        if not handle:
-            raise ValueError("the tree was closed")
-        return handle
-
-    def _copy(self, struct, count, copy):
-        handle = self._live()
-        out = np.zeros(count(handle), dtype=np.dtype(struct))
-        _check(copy(handle, out.ctypes.data_as(ctypes.POINTER(struct)), out.size))
+    def _copy(self, who, struct, count, copy):
+        with self._use(who) as handle:
+            out = np.zeros(count(handle), dtype=np.dtype(struct))
+            _check(copy(handle, out.ctypes.data_as(ctypes.POINTER(struct)), out.size))
         return out
 
     @property
     def nodes(self):
         """Every node: parent, first_child, child_count, kind (0 V, 1 T, 2 S), depth,
         sample_count, t_node, cluster, center (3), half."""
-        return self._copy(_ffi.Node, lib.vstree_tree_node_count, lib.vstree_tree_copy_nodes)
+        return self._copy("Tree.nodes", _ffi.Node, lib.vstree_tree_node_count, lib.vstree_tree_copy_nodes)
 
     @property
     def t_nodes(self):
         """The T-layer: node, depth, sample_count, cluster_count, cube_center, cube_half,
         origin, normal, u, v, square_center, square_half."""
-        return self._copy(_ffi.TNode, lib.vstree_tree_t_node_count, lib.vstree_tree_copy_t_nodes)
+        return self._copy("Tree.t_nodes", _ffi.TNode, lib.vstree_tree_t_node_count, lib.vstree_tree_copy_t_nodes)
 
     @property
     def levels(self):
         """Node counts per depth: v_nodes, t_nodes, s_nodes, leaves."""
-        return self._copy(_ffi.TreeLevel, lib.vstree_tree_level_count, lib.vstree_tree_copy_levels)
+        return self._copy("Tree.levels", _ffi.TreeLevel, lib.vstree_tree_level_count, lib.vstree_tree_copy_levels)
 
     def vertex_labels(self, kind="cluster"):
         """One uint32 per input vertex: its cluster ("cluster") or its T-node's index in
@@ -577,9 +658,9 @@ class Tree:
         kinds = {"cluster": 0, "t_node": 1}
         if not isinstance(kind, str) or kind not in kinds:
             raise ValueError("Tree.vertex_labels: `kind` must be 'cluster' or 't_node', not %r" % (kind,))
-        handle = self._live()
-        out = np.empty(lib.vstree_tree_vertex_count(handle), np.uint32)
-        _check(lib.vstree_tree_copy_vertex_labels(handle, kinds[kind], out.ctypes.data_as(_ffi._U32P), out.size))
+        with self._use("Tree.vertex_labels") as handle:
+            out = np.empty(lib.vstree_tree_vertex_count(handle), np.uint32)
+            _check(lib.vstree_tree_copy_vertex_labels(handle, kinds[kind], out.ctypes.data_as(_ffi._U32P), out.size))
         return out
 
 
@@ -651,7 +732,8 @@ def reconstruct(cloud, normals=None, progress=None, **params):
     _set_options("vstree.reconstruct", p, params, _RECONSTRUCT_FIELDS)
     cb = _Progress("vstree.reconstruct", progress)
     result = ctypes.c_void_p()
-    cb.check(lib.vstree_reconstruct(mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
+    with mesh._use("vstree.reconstruct") as handle:
+        cb.check(lib.vstree_reconstruct(handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
     try:
         stats = lib.vstree_reconstruct_result_get_stats(result).contents
         if stats.struct_size < ctypes.sizeof(_ffi.ReconstructStats):
@@ -686,9 +768,10 @@ def estimate_normals(cloud, normals=None, progress=None, **params):
     report.struct_size = ctypes.sizeof(_ffi.NormalsReport)
     cb = _Progress("vstree.estimate_normals", progress)
     out = ctypes.c_void_p()
-    cb.check(
-        lib.vstree_estimate_normals(
-            mesh._live(), ctypes.byref(p), cb.c_function, None, ctypes.byref(out), ctypes.byref(report)
+    with mesh._use("vstree.estimate_normals") as handle:
+        cb.check(
+            lib.vstree_estimate_normals(
+                handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(out), ctypes.byref(report)
+            )
         )
-    )
     return NormalsResult(Mesh._wrap(out.value), _struct_dict(report))

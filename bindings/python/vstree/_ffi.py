@@ -273,6 +273,10 @@ _SIGNATURES = {
         status_t,
         [_F32P, c_size_t, _F32P, _U32P, c_size_t, POINTER(c_void_p)],
     ),
+    "vstree_mesh_create_f64": (
+        status_t,
+        [_F64P, c_size_t, _F32P, _U32P, c_size_t, POINTER(c_void_p)],
+    ),
     "vstree_mesh_load": (status_t, [c_char_p, POINTER(c_void_p)]),
     "vstree_mesh_load_memory": (status_t, [c_void_p, c_size_t, c_char_p, POINTER(c_void_p)]),
     "vstree_mesh_save": (status_t, [c_void_p, c_char_p, c_uint32]),
