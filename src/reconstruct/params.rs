@@ -97,8 +97,9 @@ impl ReconstructParams {
             return Err(Error::param(
                 "d_a",
                 format!(
-                    "{}: the height-field test nj·n̄ > d_a can never hold, so no cell becomes a T-node and \
-                     there is no base mesh; reconstruction needs d_a below 1 (default {})",
+                    "{}: the height-field test (every normal's dot product with the cell's mean normal \
+                     above d_a) can never hold, so no cell becomes a T-node and there is no base mesh; \
+                     reconstruction needs d_a below 1 (default {})",
                     self.tree.d_a,
                     TreeParams::default().d_a
                 ),
@@ -108,8 +109,9 @@ impl ReconstructParams {
             return Err(Error::param(
                 "d_d",
                 format!(
-                    "{}: the height-field test |(pj - c)·n̄| < d_d·max|pk - c| can never hold, so no cell \
-                     becomes a T-node and there is no base mesh; reconstruction needs d_d above 0 (default {:.4})",
+                    "{}: the height-field test (every sample's height over the cell's plane below d_d \
+                     times the cell's radius) can never hold, so no cell becomes a T-node and there is no \
+                     base mesh; reconstruction needs d_d above 0 (default {:.4})",
                     self.tree.d_d,
                     TreeParams::default().d_d
                 ),
