@@ -33,6 +33,9 @@ pub(crate) struct Collapser {
     stamp: u32,
     /// Vertices on a border (an edge with one face), which keep their border manifold.
     border: Vec<bool>,
+    /// Vertices that may be on an edge with more than two faces (a superset: a vertex merged
+    /// into another passes its flag on); see [`Collapser::holds_non_manifold_edge`].
+    non_manifold: Vec<bool>,
     /// With [`Collapser::limit_border_runs`]: the longest box diagonal of the border
     /// vertices one border vertex may absorb, and per vertex the box (low, high corners) of
     /// those it has.
@@ -49,7 +52,7 @@ impl Collapser {
                 head[v as usize] = (3 * t + k) as u32;
             }
         }
-        let border = border_vertices(mesh, &head, &next);
+        let (border, non_manifold) = edge_vertices(mesh, &head, &next);
         Collapser {
             triangles: mesh.triangles.clone(),
             alive_face: vec![true; mesh.triangles.len()],
@@ -61,6 +64,7 @@ impl Collapser {
             mark: vec![0; mesh.positions.len()],
             stamp: 1,
             border,
+            non_manifold,
             border_runs: None,
         }
     }
@@ -165,6 +169,9 @@ impl Collapser {
             t.contains(&v) && t.iter().any(|&w| w != u && w != v && self.faces(w).count() == 1)
         });
         let Some(f) = ear else { return false };
+        if self.holds_non_manifold_edge(f) {
+            return false;
+        }
         let tip = self.triangles[f as usize].into_iter().find(|&w| w != u && w != v).unwrap_or(u);
         self.alive_face[f as usize] = false;
         self.alive_vertex[tip as usize] = false;
@@ -249,6 +256,9 @@ impl Collapser {
                 if shared_count == 2 {
                     return false; // more than two faces on the edge: not a manifold edge
                 }
+                if self.holds_non_manifold_edge(f) {
+                    return false;
+                }
                 shared_count += 1;
             }
         }
@@ -282,6 +292,9 @@ impl Collapser {
             }
         }
         let Some(f) = shared else { return false };
+        if self.holds_non_manifold_edge(f) {
+            return false;
+        }
         let t = self.triangles[f as usize];
         let w = t.into_iter().find(|&x| x != u && x != v).unwrap_or(u);
         if self.border[w as usize] && self.edge_faces(u, w) == 1 && self.edge_faces(v, w) == 1 {
@@ -289,6 +302,18 @@ impl Collapser {
         }
         let (_, _, common) = self.rings_and_common(u, v);
         common == 1
+    }
+
+    /// Whether face `f` has an edge with more than two faces. Such a face never dies: the link
+    /// condition assumes a manifold, and where sheets meet at an edge (a flap on a closed
+    /// surface) a collapse that takes the flap's last face off the edge leaves it manifold and
+    /// the flap, with its border, gone.
+    fn holds_non_manifold_edge(&self, f: u32) -> bool {
+        let t = self.triangles[f as usize];
+        (0..3).any(|k| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            self.non_manifold[a as usize] && self.non_manifold[b as usize] && self.edge_faces(a, b) > 2
+        })
     }
 
     /// The live faces on edge u-v.
@@ -326,6 +351,7 @@ impl Collapser {
         self.head[v as usize] = list;
         self.head[u as usize] = NO_CORNER;
         self.alive_vertex[u as usize] = false;
+        self.non_manifold[v as usize] |= self.non_manifold[u as usize];
         // A border vertex stays at the mean of the border vertices it absorbed, so the
         // border keeps its place.
         let (u, v) = (u as usize, v as usize);
@@ -392,17 +418,17 @@ impl Collapser {
     }
 }
 
-/// The vertices on an edge that only one face has, from the corner lists `head`/`next` of
-/// [`Collapser`]: each vertex counts its edges in the faces around it (a face with the vertex at
-/// two corners once), so no sort of all the edges is needed: a quarter of the time on 270k
-/// triangles.
-fn border_vertices(mesh: &Mesh, head: &[u32], next: &[u32]) -> Vec<bool> {
+/// The vertices on an edge that only one face has (the border), and those on an edge that
+/// more than two faces have, from the corner lists `head`/`next` of [`Collapser`]: each vertex
+/// counts its edges in the faces around it (a face with the vertex at two corners once), so no
+/// sort of all the edges is needed: a quarter of the time on 270k triangles.
+fn edge_vertices(mesh: &Mesh, head: &[u32], next: &[u32]) -> (Vec<bool>, Vec<bool>) {
     let mut border = vec![false; mesh.positions.len()];
+    let mut non_manifold = vec![false; mesh.positions.len()];
     let mut ends: Vec<u32> = Vec::new();
-    for (v, flag) in border.iter_mut().enumerate() {
-        let v = v as u32;
+    for v in 0..mesh.positions.len() {
         ends.clear();
-        let (mut c, mut last_face) = (head[v as usize], u32::MAX);
+        let (mut c, mut last_face) = (head[v], u32::MAX);
         while c != NO_CORNER {
             let f = c / 3;
             // A face's corners are listed next to each other: count each face once.
@@ -410,9 +436,9 @@ fn border_vertices(mesh: &Mesh, head: &[u32], next: &[u32]) -> Vec<bool> {
                 let t = mesh.triangles[f as usize];
                 for k in 0..3 {
                     let (a, b) = (t[k], t[(k + 1) % 3]);
-                    if a == v {
+                    if a as usize == v {
                         ends.push(b);
-                    } else if b == v {
+                    } else if b as usize == v {
                         ends.push(a);
                     }
                 }
@@ -421,20 +447,12 @@ fn border_vertices(mesh: &Mesh, head: &[u32], next: &[u32]) -> Vec<bool> {
             c = next[c as usize];
         }
         ends.sort_unstable();
-        let mut i = 0;
-        while i < ends.len() {
-            let mut j = i + 1;
-            while j < ends.len() && ends[j] == ends[i] {
-                j += 1;
-            }
-            if j - i == 1 {
-                *flag = true;
-                break;
-            }
-            i = j;
+        for faces in ends.chunk_by(|a, b| a == b).map(<[u32]>::len) {
+            border[v] |= faces == 1;
+            non_manifold[v] |= faces > 2;
         }
     }
-    border
+    (border, non_manifold)
 }
 
 #[cfg(test)]

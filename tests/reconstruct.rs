@@ -523,12 +523,16 @@ fn bad_input_is_refused_clearly() {
     nan.positions[7].x = f32::NAN;
     assert!(reconstruct(&nan, &Default::default(), &mut Progress::none()).unwrap_err().to_string().contains('7'));
     let sphere = shapes::sample_surface(&shapes::icosphere(1.0, 3), 2_000, 1);
+    let tree = ReconstructParams::default().tree;
     for (params, name) in [
         (ReconstructParams { max_levels: 99, ..Default::default() }, "max_levels"),
         (ReconstructParams { trim: -1.0, ..Default::default() }, "trim"),
         (ReconstructParams { max_grid_depth: 50, ..Default::default() }, "max_grid_depth"),
         (ReconstructParams { target_distance: f64::NAN, ..Default::default() }, "target_distance"),
         (ReconstructParams { max_triangles: 0, ..Default::default() }, "max_triangles"),
+        // The height-field test can never hold at these ends: no T-layer, no base mesh.
+        (ReconstructParams { tree: TreeParams { d_a: 1.0, ..tree }, ..Default::default() }, "d_a"),
+        (ReconstructParams { tree: TreeParams { d_d: 0.0, ..tree }, ..Default::default() }, "d_d"),
     ] {
         match reconstruct(&sphere, &params, &mut Progress::none()) {
             Err(Error::InvalidParameter { name: got, .. }) => assert_eq!(got, name),
@@ -543,4 +547,77 @@ fn bad_input_is_refused_clearly() {
     // Cancelling stops with Cancelled.
     let mut stop = |f: f32, _: &str| f < 0.5;
     assert!(matches!(reconstruct(&sphere, &Default::default(), &mut Progress::new(&mut stop)), Err(Error::Cancelled)));
+}
+
+/// `cloud` with every position multiplied by `scale`.
+fn scaled(cloud: &Mesh, scale: f32) -> Mesh {
+    Mesh::from_points(cloud.positions.iter().map(|&p| p * scale).collect(), cloud.normals.clone())
+}
+
+#[test]
+fn a_cloud_reconstructs_alike_at_any_scale() {
+    // Within the documented coordinate range (1e18), a cloud's units must not matter: at
+    // powers of two the work is the same to the bit, at other scales the same shape.
+    let cloud = sphere_points(3_000, |_| true);
+    let (unit, unit_stats) = run(&cloud, &ReconstructParams::default());
+    for exponent in [-50, -20, 20, 47, 56] {
+        let scale = 2f32.powi(exponent);
+        let (mesh, stats) = run(&scaled(&cloud, scale), &ReconstructParams::default());
+        assert_eq!(stats.output_triangles, unit_stats.output_triangles, "2^{exponent}");
+        let back: Vec<Vec3> = mesh.positions.iter().map(|&p| p / scale).collect();
+        assert_eq!(back, unit.positions, "2^{exponent}: the same vertices, scaled");
+    }
+    for scale in [1e-15f32, 1e14, 1e15, 1e16, 1e17] {
+        let (mesh, stats) = run(&scaled(&cloud, scale), &ReconstructParams::default());
+        let report = topology::analyze(&mesh);
+        assert!(report.is_watertight() && report.genus() == Some(0), "{scale:e}: {report:?}");
+        let worst = mesh.positions.iter().map(|p| (p.length() / scale - 1.0).abs()).fold(0.0, f32::max);
+        assert!(worst < 0.01, "{scale:e}: a vertex {worst} off the sphere's radius");
+        assert_eq!(stats.isolated_points, 0);
+    }
+}
+
+#[test]
+fn isolated_points_far_away_are_left_out() {
+    // One stray point 1000 diameters away once stretched the grid until the sphere was
+    // smaller than a cell; it and a clump of three are left out, and the sphere comes out as
+    // it does alone.
+    let cloud = sphere_points(3_000, |_| true);
+    let (alone, _) = run(&cloud, &ReconstructParams::default());
+    let mut stray = cloud.clone();
+    let far = [
+        Vec3::new(2000.0, 0.0, 0.0),
+        Vec3::new(0.0, -40.0, 0.0),
+        Vec3::new(0.0, -40.01, 0.0),
+        Vec3::new(0.01, -40.0, 0.0),
+    ];
+    stray.positions.extend(far);
+    stray.normals.as_mut().unwrap().extend([Vec3::X; 4]);
+    let (mesh, stats) = run(&stray, &ReconstructParams::default());
+    assert_eq!(stats.isolated_points, 4);
+    assert_eq!(stats.tree.samples, cloud.positions.len());
+    assert_eq!(mesh.triangles.len(), alone.triangles.len());
+    let moved = mesh.positions.iter().zip(&alone.positions).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max);
+    assert!(moved < 1e-4, "a vertex moved {moved}");
+}
+
+#[test]
+fn a_cloud_that_samples_no_surface_says_so() {
+    // Ten points scattered in a cube: no orientation of theirs encloses a volume. The message
+    // names the likely causes, not the paper's blended planes, which the default does not use.
+    let mut rng = vstree::rng::Rng::new(3);
+    let mut failures = 0;
+    for _ in 0..8 {
+        let points: Vec<Vec3> = (0..10).map(|_| Vec3::new(rng.f32(), rng.f32(), rng.f32())).collect();
+        if let Err(e) = reconstruct(&Mesh::from_points(points, None), &Default::default(), &mut Progress::none()) {
+            let message = e.to_string();
+            assert!(
+                message.contains("10 points, normals estimated: too few or too scattered to sample a surface"),
+                "{message}"
+            );
+            assert!(!message.contains("blended"), "{message}");
+            failures += 1;
+        }
+    }
+    assert!(failures >= 4, "only {failures} of 8 scattered clouds failed");
 }

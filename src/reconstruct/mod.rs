@@ -28,6 +28,7 @@ mod base_mesh;
 mod implicit;
 mod leaf_fit;
 mod mls;
+mod outliers;
 mod params;
 mod refine;
 mod relax;
@@ -180,7 +181,28 @@ pub fn reconstruct(
     normals::refuse_flat(&cloud.positions, &threads)?;
     let mut stats = ReconstructStats::default();
     let start = Instant::now();
-    let mut oriented = Mesh::from_points(cloud.positions.clone(), cloud.normals.clone());
+    // The work is done at unit size, so that no tolerance depends on the cloud's units: once
+    // for the whole cloud, and again without its isolated points.
+    let mut scale = unit_scale(&cloud.positions);
+    let mut positions: Vec<Vec3> = cloud.positions.iter().map(|&p| p * scale).collect();
+    let mut given_normals = cloud.normals.clone();
+    let isolated = outliers::isolated_points(&positions, &threads)?;
+    stats.isolated_points = isolated.iter().filter(|&&i| i).count();
+    if stats.isolated_points > 0 {
+        keep_unmarked(&mut positions, &isolated);
+        given_normals.iter_mut().for_each(|n| keep_unmarked(n, &isolated));
+        if positions.len() < MIN_POINTS {
+            return Err(Error::input(format!(
+                "{} points once {} isolated ones are left out: at least {MIN_POINTS} are needed",
+                positions.len(),
+                stats.isolated_points
+            )));
+        }
+        let rescale = unit_scale(&positions);
+        positions.iter_mut().for_each(|p| *p *= rescale);
+        scale *= rescale;
+    }
+    let mut oriented = Mesh::from_points(positions, given_normals);
     let normal_params = NormalParams { threads: params.threads, ..params.normals };
     stats.normals = normals::ensure_normals(&mut oriented, &normal_params, &mut progress.stage(0.0, 0.15))?;
     let kept_given = stats.normals.estimated == 0 && stats.normals.orient.is_none();
@@ -272,6 +294,12 @@ pub fn reconstruct(
         let seeds = sample_cells(&grid, &tree.samples, offset, &threads);
         track_surface(&|p| f(p, open) - offset, &grid, &seeds, MAX_GRID_CELLS, &threads)
     };
+    // What a cloud that gives no surface most likely is.
+    let too_sparse_or_unoriented = format!(
+        "{} points{}: too few or too scattered to sample a surface, or normals that do not face one way",
+        tree.samples.len(),
+        if stats.normals.estimated > 0 { ", normals estimated" } else { ", normals given" }
+    );
     let sag = plane_sags(&tree, &threads);
     let sample_normals: Vec<Vec3> = tree.samples.iter().map(|s| s.normal).collect();
     let smallest_hole = f64::from(2.0 * typical_t_half).powi(2);
@@ -292,9 +320,17 @@ pub fn reconstruct(
             }
         }
         if fine.triangles.is_empty() {
-            return Err(Error::input(
-                "the blended T-node planes have no zero crossing near the samples (are the normals consistent?)",
-            ));
+            return Err(Error::input(match params.base_mesh {
+                BaseMesh::Winding => format!(
+                    "the points enclose no volume: their winding number stays below one half everywhere \
+                     near them ({})",
+                    too_sparse_or_unoriented
+                ),
+                BaseMesh::Paper => format!(
+                    "the blended T-node planes have no zero crossing near the samples ({})",
+                    too_sparse_or_unoriented
+                ),
+            }));
         }
         let neighbours = adjacency::Rows::neighbours(&fine.triangles, fine.positions.len());
         if thickened {
@@ -326,8 +362,7 @@ pub fn reconstruct(
     let neighbours = if stats.open {
         // An open M0 is made of the supported part only: the closing sheet never joins a
         // T-node's cluster.
-        let mut u = unsupported.iter();
-        fine.triangles.retain(|_| !*u.next().unwrap_or(&false));
+        keep_unmarked(&mut fine.triangles, &unsupported);
         // Parts left smaller than the smallest hole are shreds of the closing sheet's edge.
         drop_small_parts(&mut fine, smallest_hole);
         adjacency::Rows::neighbours(&fine.triangles, fine.positions.len())
@@ -344,9 +379,11 @@ pub fn reconstruct(
     }
     drop((fine, labels, neighbours));
     if base.mesh.triangles.is_empty() {
-        return Err(Error::input(
-            "the base mesh is empty: every part of the polygonised surface was too small for the tree's T-layer",
-        ));
+        return Err(Error::input(format!(
+            "the base mesh is empty: every part of the polygonised surface was smaller than the tree's \
+             T-layer can stand for ({})",
+            too_sparse_or_unoriented
+        )));
     }
     stats.base_vertices = base.mesh.positions.len();
     stats.base_triangles = base.mesh.triangles.len();
@@ -425,6 +462,7 @@ pub fn reconstruct(
             trim::border(&mut mesh, &sample_index, BORDER_TRIM * spacing, &threads)
         };
     }
+    mesh.positions.iter_mut().for_each(|p| *p /= scale);
     stats.seconds_trim = t3.elapsed().as_secs_f64();
     progress.report(1.0, "done")?;
     stats.output_vertices = mesh.positions.len();
@@ -433,6 +471,25 @@ pub fn reconstruct(
     stats.seconds_base = (t2 - t1).as_secs_f64();
     stats.seconds_refine = (t3 - t2).as_secs_f64();
     Ok((mesh, stats))
+}
+
+/// Keeps the items of `items` whose mark is false, in order.
+fn keep_unmarked<T>(items: &mut Vec<T>, marks: &[bool]) {
+    let mut mark = marks.iter();
+    items.retain(|_| !*mark.next().unwrap_or(&false));
+}
+
+/// The power of two that brings the bounding box's diagonal of `points` to between 1/√2 and √2.
+/// Reconstruction runs on the scaled cloud: tolerances fixed in f32 (a normal too short to
+/// trust, a cell too small to split, a squared distance that underflows or loses its digits)
+/// would otherwise depend on the units, and a cloud 1e-15 or 1e17 across fails where the same
+/// cloud at unit size does not. A power of two scales every f32 exactly, both ways.
+fn unit_scale(points: &[Vec3]) -> f32 {
+    let diagonal = crate::mesh::Aabb::of(points).map_or(1.0, |b| f64::from(b.diagonal()));
+    if !(diagonal.is_finite() && diagonal > 0.0) {
+        return 1.0;
+    }
+    2f32.powi(-(diagonal.log2().round() as i32))
 }
 
 /// The implicit function's zero set, polygonised, and what the base mesh needs of it.

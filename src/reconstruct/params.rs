@@ -90,6 +90,33 @@ impl ReconstructParams {
                  for simplification)",
             ));
         }
+        // At these ends of their ranges the height-field test passes only where a cell's samples
+        // are all at one point, so the T-layer, and the base mesh made of it, misses the
+        // surface. Fine for simplification (the tree is then an octree), not here.
+        if self.tree.d_a >= 1.0 {
+            return Err(Error::param(
+                "d_a",
+                format!(
+                    "{}: the height-field test (every normal's dot product with the cell's mean normal \
+                     above d_a) can never hold, so no cell becomes a T-node and there is no base mesh; \
+                     reconstruction needs d_a below 1 (default {})",
+                    self.tree.d_a,
+                    TreeParams::default().d_a
+                ),
+            ));
+        }
+        if self.tree.d_d <= 0.0 {
+            return Err(Error::param(
+                "d_d",
+                format!(
+                    "{}: the height-field test (every sample's height over the cell's plane below d_d \
+                     times the cell's radius) can never hold, so no cell becomes a T-node and there is no \
+                     base mesh; reconstruction needs d_d above 0 (default {:.4})",
+                    self.tree.d_d,
+                    TreeParams::default().d_d
+                ),
+            ));
+        }
         if !(self.target_distance.is_finite() && self.target_distance >= 0.0) {
             return Err(Error::param(
                 "target_distance",
@@ -164,6 +191,9 @@ impl RefinementStop {
 pub struct ReconstructStats {
     /// What was done to the normals.
     pub normals: NormalsReport,
+    /// Points left out as isolated: far from the rest for their neighbours' spacing (see
+    /// `outliers`).
+    pub isolated_points: usize,
     pub tree: TreeStats,
     /// Cells across the polygonisation grid (a power of two).
     pub grid_cells: u32,

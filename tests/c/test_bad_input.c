@@ -825,6 +825,8 @@ RECONSTRUCT_PARAM(reconstruct_d_a_neg, d_a, -0.5f)
 RECONSTRUCT_PARAM(reconstruct_d_a_nan, d_a, NAN)
 RECONSTRUCT_PARAM(reconstruct_d_d_big, d_d, 1.5f)
 RECONSTRUCT_PARAM(reconstruct_d_d_inf, d_d, INFINITY)
+RECONSTRUCT_PARAM(reconstruct_d_a_one, d_a, 1.0f)
+RECONSTRUCT_PARAM(reconstruct_d_d_zero, d_d, 0.0f)
 RECONSTRUCT_PARAM(reconstruct_max_depth_zero, max_depth, 0)
 RECONSTRUCT_PARAM(reconstruct_max_depth_31, max_depth, 31)
 RECONSTRUCT_PARAM(reconstruct_max_levels_13, max_levels, 13)
@@ -1638,6 +1640,15 @@ static const bad_case g_cases[] = {
         "vstree_reconstruct: parameter `error`: NaN: must be a finite number > 0"),
     ROW(reconstruct_error_inf, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `error`: inf: must be a finite number > 0"),
+    ROW(reconstruct_d_a_one, INVALID_PARAMETER,
+        "vstree_reconstruct: parameter `d_a`: 1: the height-field test (every normal's dot "
+        "product with the cell's mean normal above d_a) can never hold, so no cell becomes a "
+        "T-node and there is no base mesh; reconstruction needs d_a below 1 (default 0)"),
+    ROW(reconstruct_d_d_zero, INVALID_PARAMETER,
+        "vstree_reconstruct: parameter `d_d`: 0: the height-field test (every sample's height "
+        "over the cell's plane below d_d times the cell's radius) can never hold, so no cell "
+        "becomes a T-node and there is no base mesh; reconstruction needs d_d above 0 (default "
+        "0.1667)"),
     ROW(reconstruct_d_a_neg, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `d_a`: -0.5: must be in [0, 1]"),
     ROW(reconstruct_d_a_nan, INVALID_PARAMETER,

@@ -340,6 +340,15 @@ PARAMETER_CASES = [
          "vstree_reconstruct: parameter `error`: 0: must be a finite number > 0"),
     case("reconstruct-d_a-too-big", reconstruct_with(d_a=1.5), vstree.VstreeError, BAD,
          "vstree_reconstruct: parameter `d_a`: 1.5: must be in [0, 1]"),
+    # At these ends the height-field test never holds: refused before the work (issue 26, 7).
+    case("reconstruct-d_a-one", reconstruct_with(d_a=1.0), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `d_a`: 1: the height-field test (every normal's dot product "
+         "with the cell's mean normal above d_a) can never hold, so no cell becomes a T-node and there "
+         "is no base mesh; reconstruction needs d_a below 1 (default 0)"),
+    case("reconstruct-d_d-zero", reconstruct_with(d_d=0.0), vstree.VstreeError, BAD,
+         "vstree_reconstruct: parameter `d_d`: 0: the height-field test (every sample's height over the "
+         "cell's plane below d_d times the cell's radius) can never hold, so no cell becomes a T-node "
+         "and there is no base mesh; reconstruction needs d_d above 0 (default 0.1667)"),
     case("reconstruct-max_depth-zero", reconstruct_with(max_depth=0), vstree.VstreeError, BAD,
          "vstree_reconstruct: parameter `max_depth`: 0: must be from 1 to 30"),
     case("reconstruct-max_levels-too-big", reconstruct_with(max_levels=13), vstree.VstreeError, BAD,
