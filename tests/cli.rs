@@ -412,3 +412,68 @@ fn a_file_size_limit_is_a_write_error() {
     assert_eq!(names, vec!["out.ply", "sphere.ply"]);
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// A cloud far beyond unit size, with one stray point 1000 diameters away: reconstructed, the
+/// stray point left out and said (issue 26: "the blended T-node planes have no zero crossing"
+/// at 1e14-1e17, "the base mesh is empty" with the stray point).
+#[test]
+fn a_huge_cloud_with_a_stray_point_is_reconstructed() {
+    let dir = temp_dir("stray");
+    let cloud = shapes::sample_surface(&shapes::icosphere(1.0, 4), 3_000, 5);
+    let scale = 1e14f32;
+    let mut positions: Vec<glam::Vec3> = cloud.positions.iter().map(|&p| p * scale).collect();
+    let mut normals = cloud.normals.unwrap();
+    positions.push(glam::Vec3::new(2000.0 * scale, 0.0, 0.0));
+    normals.push(glam::Vec3::X);
+    let input = dir.join("cloud.ply");
+    io::write(&input, &vstree::Mesh::from_points(positions, Some(normals))).unwrap();
+    let output = dir.join("out.ply");
+    let run = vstree(&["reconstruct", input.to_str().unwrap(), output.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(stdout.contains("isolated points: 1 left out"), "{stdout}");
+    let mesh = io::read(&output).unwrap();
+    let report = vstree::topology::analyze(&mesh);
+    assert!(report.is_watertight() && report.genus() == Some(0), "{report:?}");
+    let worst = (0..mesh.positions.len())
+        .map(|i| (mesh.absolute(i).length() / f64::from(scale) - 1.0).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 0.01, "a vertex {worst} off the sphere's radius");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `--keep-topology` keeps a flap's border (issue 26: a sphere with a strip joined along one
+/// edge lost the strip and its border).
+#[test]
+fn keeping_topology_keeps_a_flaps_border() {
+    let dir = temp_dir("flap");
+    let mut mesh = shapes::icosphere(1.0, 3);
+    mesh.normals = None;
+    let [a, b, _] = mesh.triangles[0];
+    let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+    let out = (pa + pb).normalize() * pa.distance(pb);
+    let mut base = (a, b);
+    for row in 1..=20u32 {
+        let next = mesh.positions.len() as u32;
+        mesh.positions.extend([pa + out * row as f32, pb + out * row as f32]);
+        mesh.triangles.extend([[base.0, base.1, next + 1], [base.0, next + 1, next]]);
+        base = (next, next + 1);
+    }
+    let input = dir.join("flap.ply");
+    io::write(&input, &mesh).unwrap();
+    for bound in ["1e-3", "3e-2"] {
+        let output = dir.join(format!("out-{bound}.ply"));
+        let run = vstree(&[
+            "simplify",
+            input.to_str().unwrap(),
+            output.to_str().unwrap(),
+            "--keep-topology",
+            "--error",
+            bound,
+        ]);
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        let r = vstree::topology::analyze(&io::read(&output).unwrap());
+        assert!(r.boundary_edges >= 2 && r.non_manifold_edges == 1, "--error {bound}: {r:?}");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -150,6 +150,8 @@ fn cases() -> Vec<Case> {
     let plane: Vec<Vec3> = (0..900).map(|i| Vec3::new((i % 30) as f32, (i / 30) as f32, 0.0)).collect();
     let line: Vec<Vec3> = (0..500).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect();
     let long_name = format!("{}.ply", "a".repeat(240));
+    let mut rng = vstree::rng::Rng::new(1);
+    let scattered: String = (0..10).map(|_| format!("{} {} {}\n", rng.f32(), rng.f32(), rng.f32())).collect();
 
     let mut cases = vec![
         // --error, on every command.
@@ -401,6 +403,15 @@ fn cases() -> Vec<Case> {
         ),
         fail("reconstruct --tree octree", vec![cloud_ply()], &reconstruct_with(&["--tree", "octree"]), error("--tree: octree: reconstruction needs the VS-Tree, whose T-nodes make the base mesh (the octree is for simplification)")),
         fail("reconstruct --max-depth 1", vec![cloud_ply()], &reconstruct_with(&["--max-depth", "1", "-q"]), error("--max-depth: 1: the tree reached this depth before any cell saw the surface as a height field, so there is nothing to make the base mesh from; allow a deeper tree (default 24)")),
+        // At these ends no cell passes the height-field test: refused before the work.
+        fail("reconstruct --da 1", vec![cloud_ply()], &reconstruct_with(&["--da", "1", "-q"]), error("--da: 1: the height-field test (every normal's dot product with the cell's mean normal above d_a) can never hold, so no cell becomes a T-node and there is no base mesh; reconstruction needs d_a below 1 (default 0)")),
+        fail("reconstruct --dd 0", vec![cloud_ply()], &reconstruct_with(&["--dd", "0", "-q"]), error("--dd: 0: the height-field test (every sample's height over the cell's plane below d_d times the cell's radius) can never hold, so no cell becomes a T-node and there is no base mesh; reconstruction needs d_d above 0 (default 0.1667)")),
+        fail(
+            "reconstruct ten scattered points",
+            vec![text("scattered.xyz", &scattered)],
+            &["reconstruct", "scattered.xyz", "out.ply", "-q"],
+            contains(&["vstree: error: invalid input: ", "(10 points, normals estimated: too few or too scattered to sample a surface, or normals that do not face one way)\n"]),
+        ),
         fail("reconstruct --error 1e300", vec![cloud_ply()], &reconstruct_with(&["--error", "1e300", "-q"]), error("--error: 1e300: the cloud fits this bound in 1 octree cell too coarse to see the surface as a height field, so there is nothing to make the base mesh from; use a smaller bound (default 1e-5)")),
         fail(
             "reconstruct a flat plane",

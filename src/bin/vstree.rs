@@ -695,6 +695,9 @@ fn print_reconstruct(
     write_s: f64,
 ) -> vstree::Result<()> {
     say!("{}: {} points", input.display(), points);
+    if s.isolated_points > 0 {
+        say!("isolated points: {} left out (far from the rest for their neighbours' spacing)", s.isolated_points);
+    }
     if s.normals.estimated > 0 {
         say!("normals: {} estimated from {} neighbours", s.normals.estimated, s.normals.neighbours);
     }
