@@ -1,10 +1,11 @@
 //! Reading an input file with bounds: only regular files are read (a device, a FIFO or a
 //! socket could be endless or block forever), never more than the size the file had when it
-//! was opened, and the first [`PREFIX_BYTES`] are checked against the format before the rest
-//! is read, so a file of another kind fails at once and with little memory whatever its size.
+//! was opened, and only as far as the reader gets: [`Input`] pulls bytes from the file as the
+//! reader asks for them, so a reader that stops (at the end of the elements a PLY header
+//! declares, or at a byte no file of its format holds) leaves the rest of the file unread.
 
-use super::Format;
 use crate::error::{Error, Result};
+use std::borrow::Cow;
 use std::fs::{File, Metadata, OpenOptions};
 use std::io::{self, Read};
 use std::path::Path;
@@ -13,22 +14,120 @@ use std::path::Path;
 /// many lines of a text format, little enough to be instant.
 pub(crate) const PREFIX_BYTES: usize = 64 * 1024;
 
-/// The whole content of the regular file at `path`, once its start looks like `format`.
-pub(crate) fn read(path: &Path, format: Format) -> Result<Vec<u8>> {
+/// The least an [`Input`] reads from its source at a time, so that readers asking for a few
+/// bytes at a time do not make a system call each. Reading stops at most this far past the
+/// last byte a reader asked for.
+const CHUNK: usize = 64 * 1024;
+
+/// Runs `read` on the bytes of the regular file at `path`, pulled from the file as `read` asks
+/// for them; an error reading the file, or a file that grows meanwhile, is reported instead of
+/// what `read` returns.
+pub(crate) fn read<T>(path: &Path, read: impl FnOnce(&mut Input) -> Result<T>) -> Result<T> {
     let io_error = |e| Error::io(path, e);
     let (file, size) = open_regular(path).map_err(io_error)?;
     let size = usize::try_from(size).map_err(|_| Error::TooLarge(format!("{}: {size} bytes", path.display())))?;
     // One byte more than the size, to notice a file that grows while it is read.
-    let mut reader = file.take(size as u64 + 1);
-    let mut bytes = Vec::with_capacity(size.min(PREFIX_BYTES));
-    (&mut reader).take(PREFIX_BYTES as u64).read_to_end(&mut bytes).map_err(io_error)?;
-    format.check_start(&bytes, bytes.len() < size, path)?;
-    bytes.reserve_exact(size.saturating_sub(bytes.len()));
-    reader.read_to_end(&mut bytes).map_err(io_error)?;
-    if bytes.len() > size {
+    let mut source = file.take(size as u64 + 1);
+    let mut input = Input::reading(&mut source, size);
+    let result = read(&mut input);
+    if let Some(e) = input.failed.take() {
+        return Err(io_error(e));
+    }
+    if input.data.len() > size {
         return Err(io_error(io::Error::other("the file grew while it was read: read it once it is complete")));
     }
-    Ok(bytes)
+    result
+}
+
+/// The bytes of an input, in memory or pulled from a source as a reader asks for them.
+/// Positions are from the start of the input; what has been pulled stays in memory.
+pub(crate) struct Input<'a> {
+    data: Cow<'a, [u8]>,
+    /// Where more bytes come from; `None` once it has ended or failed, or for bytes in memory.
+    source: Option<&'a mut dyn Read>,
+    /// The input's whole size as far as it is known (a file's size when it was opened), which
+    /// bounds what a reader reserves room for.
+    size: usize,
+    /// The error that ended the source, reported by [`read`].
+    failed: Option<io::Error>,
+}
+
+impl<'a> Input<'a> {
+    /// An input whose bytes are all in memory.
+    pub(crate) fn memory(bytes: &'a [u8]) -> Input<'a> {
+        Input { data: Cow::Borrowed(bytes), source: None, size: bytes.len(), failed: None }
+    }
+
+    /// An input read from `source`, which holds about `size` bytes.
+    pub(crate) fn reading(source: &'a mut dyn Read, size: usize) -> Input<'a> {
+        Input { data: Cow::Owned(Vec::new()), source: Some(source), size, failed: None }
+    }
+
+    /// The bytes from `start` on, at least `n` of them unless the input ends before.
+    pub(crate) fn get(&mut self, start: usize, n: usize) -> &[u8] {
+        self.pull(start.saturating_add(n));
+        let data = &*self.data;
+        let end = start.saturating_add(n).min(data.len());
+        data.get(start..end).unwrap_or_default()
+    }
+
+    /// The byte at `at`, or `None` past the end of the input.
+    #[inline]
+    pub(crate) fn byte(&mut self, at: usize) -> Option<u8> {
+        if at >= self.data.len() {
+            self.pull(at + 1);
+        }
+        self.data.get(at).copied()
+    }
+
+    /// The bytes pulled so far (all of them for an input in memory).
+    pub(crate) fn pulled(&self) -> &[u8] {
+        &self.data
+    }
+
+    /// Bytes from `at` to the end of the input as far as its size is known.
+    pub(crate) fn remaining(&self, at: usize) -> usize {
+        self.size.max(self.data.len()).saturating_sub(at)
+    }
+
+    /// Reads from the source until `end` bytes are in memory or the source ends, at least
+    /// [`CHUNK`] bytes at a time.
+    fn pull(&mut self, end: usize) {
+        let have = self.data.len();
+        let Some(source) = self.source.as_mut().filter(|_| end > have) else {
+            return;
+        };
+        let want = (end - have).max(CHUNK);
+        let bytes = self.data.to_mut();
+        // Room grows geometrically (pulls are small), but never past the size of the input.
+        let room = want.max(have).min(self.size.saturating_sub(have) + 1);
+        bytes.reserve_exact(room);
+        match source.take(want as u64).read_to_end(bytes) {
+            Ok(got) if got == want => {}
+            Ok(_) => self.source = None,
+            Err(e) => {
+                self.failed = Some(e);
+                self.source = None;
+            }
+        }
+    }
+
+    /// Pulls the rest of a text file and returns all of it, refusing the first NUL byte:
+    /// none is in a text file, and pulling stops there.
+    pub(crate) fn text(&mut self, path: &Path) -> Result<&[u8]> {
+        let mut checked = 0;
+        loop {
+            let end = self.data.len();
+            if let Some(at) = self.data[checked..].iter().position(|&b| b == 0) {
+                return Err(nul_error(&self.data[..checked + at], path));
+            }
+            checked = end;
+            self.pull(end + CHUNK);
+            if self.data.len() == end {
+                return Ok(&self.data);
+            }
+        }
+    }
 }
 
 /// Opens `path` for reading if it is a regular file (links followed), with its size.
@@ -92,9 +191,115 @@ pub(crate) fn file_kind(metadata: &Metadata) -> &'static str {
 /// The error for text data holding a NUL byte, which no text format has: the file is binary
 /// (or zeros), so it is refused at the first one instead of being read whole.
 pub(crate) fn refuse_binary(bytes: &[u8], path: &Path) -> Result<()> {
-    let Some(at) = bytes.iter().position(|&b| b == 0) else {
-        return Ok(());
-    };
-    let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
-    Err(Error::parse(path, format!("line {line}"), "a NUL byte: this is binary data, not a text file"))
+    match bytes.iter().position(|&b| b == 0) {
+        Some(at) => Err(nul_error(&bytes[..at], path)),
+        None => Ok(()),
+    }
+}
+
+/// The error for a NUL byte that follows `before`.
+fn nul_error(before: &[u8], path: &Path) -> Error {
+    let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
+    Error::parse(path, format!("line {line}"), "a NUL byte: this is binary data, not a text file")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::{ply, Format};
+    use crate::mesh::Mesh;
+
+    /// A source that counts the bytes pulled from it.
+    struct Counting<R> {
+        inner: R,
+        pulled: usize,
+    }
+
+    impl<R: Read> Read for Counting<R> {
+        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            let n = self.inner.read(buf)?;
+            self.pulled += n;
+            Ok(n)
+        }
+    }
+
+    const TAIL: u64 = 2 << 30;
+
+    /// Reads `file` followed by 2 GiB of `tail_byte` (generated, never in memory) as `format`;
+    /// returns the result and how many bytes were pulled from the source.
+    fn read_with_tail(format: Format, file: &[u8], tail_byte: u8) -> (Result<Mesh>, usize) {
+        let size = file.len() + TAIL as usize;
+        let mut source = Counting { inner: file.chain(io::repeat(tail_byte).take(TAIL)), pulled: 0 };
+        let result = format.read(&mut Input::reading(&mut source, size), Path::new("t"));
+        (result, source.pulled)
+    }
+
+    fn ply_bytes(mesh: &Mesh, ascii: bool) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        ply::write(&mut bytes, mesh, ascii).unwrap();
+        bytes
+    }
+
+    #[test]
+    fn a_ply_is_read_up_to_its_declared_elements_and_a_tail_is_ignored_unread() {
+        // 10242 vertices and 20480 faces: bodies well beyond the first pull.
+        let mesh = crate::eval::shapes::icosphere(1.0, 5);
+        for ascii in [false, true] {
+            let file = ply_bytes(&mesh, ascii);
+            for tail_byte in [0, b'7', b'\n'] {
+                let (read, pulled) = read_with_tail(Format::Ply, &file, tail_byte);
+                assert_eq!(read.unwrap(), mesh, "ascii {ascii}, tail {tail_byte}");
+                assert!(
+                    pulled <= file.len() + CHUNK,
+                    "ascii {ascii}: {pulled} bytes pulled for a {} byte file",
+                    file.len()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn an_ascii_ply_body_of_nul_bytes_is_refused_at_its_first_byte() {
+        let header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                      property float z\nend_header\n";
+        let (read, pulled) = read_with_tail(Format::Ply, header.as_bytes(), 0);
+        let message = read.unwrap_err().to_string();
+        assert_eq!(message, "t: line 8: vertex 0: byte 0x00: this is binary data, but the header says `format ascii`");
+        assert_eq!(pulled, PREFIX_BYTES);
+        // The same one line on: a control byte inside a number.
+        let (read, pulled) = read_with_tail(Format::Ply, format!("{header}0 0 0\n1 \x1b").as_bytes(), b'2');
+        let message = read.unwrap_err().to_string();
+        assert_eq!(message, "t: line 9: vertex 1: byte 0x1b: this is binary data, but the header says `format ascii`");
+        assert_eq!(pulled, PREFIX_BYTES);
+    }
+
+    #[test]
+    fn a_ply_header_of_binary_bytes_is_refused_at_its_line() {
+        let (read, pulled) = read_with_tail(Format::Ply, b"ply\nformat ascii 1.0\n", 0);
+        let message = read.unwrap_err().to_string();
+        assert_eq!(message, "t: line 3: byte 0x00: this is binary data, but a PLY header is text");
+        assert_eq!(pulled, PREFIX_BYTES);
+    }
+
+    #[test]
+    fn text_formats_stop_at_their_first_nul_byte() {
+        // Past the first pull: the NUL is found where the file stops being text.
+        let lines = "0 0 0\n1 0 0\n0 1 0\n".repeat(10_000);
+        for format in [Format::Xyz, Format::Obj, Format::Off] {
+            let file = match format {
+                Format::Obj => lines.lines().map(|l| format!("v {l}\n")).collect(),
+                Format::Off => format!("OFF\n30000 0 0\n{lines}"),
+                _ => lines.clone(),
+            };
+            let (read, pulled) = read_with_tail(format, file.as_bytes(), 0);
+            let line = file.lines().count() + 1;
+            let message = read.unwrap_err().to_string();
+            assert_eq!(
+                message,
+                format!("t: line {line}: a NUL byte: this is binary data, not a text file"),
+                "{format:?}"
+            );
+            assert!(pulled <= file.len() + CHUNK, "{format:?}: {pulled} bytes pulled for {} bytes of text", file.len());
+        }
+    }
 }
