@@ -525,6 +525,17 @@ fn cases() -> Vec<Case> {
         &["stats", "e.obj"],
         error("e.obj: line 2: expected a number, found `\\u{1b}[2J`"),
     ));
+    // Vertex colours are not used, so colours on some vertices only are no error.
+    cases.push(Case {
+        quiet_stdout: false,
+        code: 0,
+        ..fail(
+            "OBJ with colours on some vertices",
+            vec![text("c.obj", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")],
+            &["stats", "c.obj", "-q"],
+            exact(""),
+        )
+    });
     cases
 }
 

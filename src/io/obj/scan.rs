@@ -46,6 +46,19 @@ pub(super) fn first_malformed(source: &str) -> Option<(usize, String)> {
     None
 }
 
+/// `source` with the colours of its `v x y z r g b` lines dropped, every line where it was.
+pub(super) fn without_colours(source: &str) -> String {
+    let mut kept = String::with_capacity(source.len());
+    for line in source.split_inclusive('\n') {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words[..] {
+            ["v", x, y, z, _, _, _] => kept.push_str(&format!("v {x} {y} {z}\n")),
+            _ => kept.push_str(line),
+        }
+    }
+    kept
+}
+
 /// The first `f` line with fewer than three corners, as `(line, what is wrong)`: tobj drops
 /// such faces without a word, where PLY and OFF readers refuse them.
 pub(super) fn first_short_face(source: &str) -> Option<(usize, String)> {
