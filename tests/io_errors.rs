@@ -317,8 +317,17 @@ fn obj_errors_name_the_line() {
     io::obj::parse(format!("{tri}p 99\nl 5 6\nf 1 2 3\n").as_bytes(), Path::new("ok.obj")).unwrap();
     expect_at(obj(&format!("{tri}f 1 2 3\nf 1 2\n")), "line 5", "a face with 2 corners: a face needs at least 3");
     expect_at(obj(&format!("{tri}f 1 # two\n")), "line 4", "a face with 1 corner: ");
-    // A forward reference across objects fails in tobj but not in the scan: whole-file location.
-    expect_at(obj("o a\nv 0 0 0\nv 1 0 0\nf 1 2 3\no b\nv 0 1 0\n"), "OBJ data", "out of bounds");
+    // A reference to a `v` line after the end of the face's object, which tobj refuses.
+    expect_at(
+        obj("o a\nv 0 0 0\nv 1 0 0\nf 1 2 3\no b\nv 0 1 0\n"),
+        "line 4",
+        "vertex index 3 is out of range: its object ends at line 5 after 2 `v` lines, and a face may only use those",
+    );
+    expect_at(
+        obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//2\nvn 0 0 1\ng b\nvn 0 0 1\n"),
+        "line 4",
+        "normal index 2 is out of range: its object ends at line 6 after 1 `vn` lines",
+    );
 }
 
 #[test]
