@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use std::borrow::Cow;
 use std::fs::{File, Metadata, OpenOptions};
 use std::io::{self, Read};
+use std::ops::Range;
 use std::path::Path;
 
 /// Bytes read and checked before the rest of a file: enough for any real PLY header and for
@@ -130,6 +131,64 @@ impl<'a> Input<'a> {
     }
 }
 
+/// The lines of a text input, pulled one at a time, as [`crate::io::text::lines`] splits bytes in memory:
+/// numbered from 1, without their `\n` or `\r\n`, invalid UTF-8 replaced. A NUL byte, which no
+/// text file holds, is refused at its line, before the rest of the input is pulled.
+pub(crate) struct Lines {
+    pos: usize,
+    number: usize,
+    ended: bool,
+}
+
+impl Lines {
+    /// The lines from byte `start` on.
+    pub(crate) fn new(start: usize) -> Lines {
+        Lines { pos: start, number: 0, ended: false }
+    }
+
+    /// The next line, or `None` after the last (which is empty when the input ends with `\n`).
+    pub(crate) fn next<'i>(&mut self, input: &'i mut Input, path: &Path) -> Result<Option<(usize, Cow<'i, str>)>> {
+        let Some((number, range)) = self.next_range(input, path)? else {
+            return Ok(None);
+        };
+        Ok(Some((number, Lines::text(input, range))))
+    }
+
+    /// The number of the next line and where its bytes are in `input`, or `None` after the last.
+    pub(crate) fn next_range(&mut self, input: &mut Input, path: &Path) -> Result<Option<(usize, Range<usize>)>> {
+        if self.ended {
+            return Ok(None);
+        }
+        let start = self.pos;
+        // Bytes from `start` known to hold neither a line feed nor a NUL.
+        let mut scanned = 0;
+        let length = loop {
+            let want = (2 * scanned).max(CHUNK);
+            let bytes = input.get(start, want);
+            match bytes[scanned..].iter().position(|&b| b == b'\n' || b == 0) {
+                Some(at) if bytes[scanned + at] == 0 => {
+                    return Err(Error::parse(path, format!("line {}", self.number + 1), NUL_BYTE));
+                }
+                Some(at) => break scanned + at,
+                None if bytes.len() < want => {
+                    self.ended = true;
+                    break bytes.len();
+                }
+                None => scanned = bytes.len(),
+            }
+        };
+        self.number += 1;
+        self.pos = start + length + 1;
+        Ok(Some((self.number, start..start + length)))
+    }
+
+    /// The text of the line at `range` (from [`Lines::next_range`]), without a final `\r`.
+    pub(crate) fn text<'i>(input: &'i Input, range: Range<usize>) -> Cow<'i, str> {
+        let line = input.pulled().get(range).unwrap_or_default();
+        String::from_utf8_lossy(line.strip_suffix(b"\r").unwrap_or(line))
+    }
+}
+
 /// Opens `path` for reading if it is a regular file (links followed), with its size.
 /// The type is checked before opening, since opening a FIFO blocks until someone writes
 /// to it, and again on the open file, in case the path was replaced in between.
@@ -200,8 +259,10 @@ pub(crate) fn refuse_binary(bytes: &[u8], path: &Path) -> Result<()> {
 /// The error for a NUL byte that follows `before`.
 fn nul_error(before: &[u8], path: &Path) -> Error {
     let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
-    Error::parse(path, format!("line {line}"), "a NUL byte: this is binary data, not a text file")
+    Error::parse(path, format!("line {line}"), NUL_BYTE)
 }
+
+const NUL_BYTE: &str = "a NUL byte: this is binary data, not a text file";
 
 #[cfg(test)]
 mod tests {
@@ -282,15 +343,11 @@ mod tests {
     }
 
     #[test]
-    fn text_formats_stop_at_their_first_nul_byte() {
+    fn text_files_are_read_up_to_their_first_nul_byte_or_bad_line() {
         // Past the first pull: the NUL is found where the file stops being text.
         let lines = "0 0 0\n1 0 0\n0 1 0\n".repeat(10_000);
-        for format in [Format::Xyz, Format::Obj, Format::Off] {
-            let file = match format {
-                Format::Obj => lines.lines().map(|l| format!("v {l}\n")).collect(),
-                Format::Off => format!("OFF\n30000 0 0\n{lines}"),
-                _ => lines.clone(),
-            };
+        let obj: String = lines.lines().map(|l| format!("v {l}\n")).collect();
+        for (format, file) in [(Format::Xyz, &lines), (Format::Obj, &obj)] {
             let (read, pulled) = read_with_tail(format, file.as_bytes(), 0);
             let line = file.lines().count() + 1;
             let message = read.unwrap_err().to_string();
@@ -299,7 +356,23 @@ mod tests {
                 format!("t: line {line}: a NUL byte: this is binary data, not a text file"),
                 "{format:?}"
             );
-            assert!(pulled <= file.len() + CHUNK, "{format:?}: {pulled} bytes pulled for {} bytes of text", file.len());
+            assert!(
+                pulled <= file.len() + 2 * CHUNK,
+                "{format:?}: {pulled} bytes pulled for {} bytes of text",
+                file.len()
+            );
         }
+        // XYZ and OFF are read line by line: a bad line ends the reading.
+        let (read, pulled) = read_with_tail(Format::Xyz, b"0 0 0\n1 x 0\n", b'7');
+        assert_eq!(read.unwrap_err().to_string(), "t: line 2: expected a number, found `x`");
+        assert_eq!(pulled, 2 * CHUNK);
+        let (read, pulled) = read_with_tail(Format::Off, b"OFF\n3 1 0\n0 0 0\n1 0 0\nx 0 0\n", b'7');
+        assert_eq!(read.unwrap_err().to_string(), "t: line 5: vertex 2: expected a number, found `x`");
+        assert_eq!(pulled, 2 * CHUNK);
+        // OFF is read up to its last declared face: a tail is ignored unread.
+        let off = format!("OFF\n30000 0 0\n{lines}");
+        let (read, pulled) = read_with_tail(Format::Off, off.as_bytes(), 0);
+        assert_eq!(read.unwrap().positions.len(), 30_000);
+        assert!(pulled <= off.len() + 2 * CHUNK, "{pulled} bytes pulled for a {} byte OFF file", off.len());
     }
 }

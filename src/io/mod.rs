@@ -55,27 +55,20 @@ impl Format {
         self.read(&mut Input::memory(bytes), path)
     }
 
-    /// Reads a file of this format from `input`, pulling only what the format needs: a PLY
-    /// file up to the end of the elements its header declares, a text file up to its end or
-    /// its first NUL byte. The start is checked before the rest is pulled, so that a file of
-    /// another kind is refused at once: a PLY header, the OFF keyword, no NUL byte in a text
-    /// format.
+    /// Reads a file of this format from `input`, pulling only what the reader needs: a PLY or
+    /// OFF file up to the end of the elements it declares, an XYZ file line by line, an OBJ
+    /// file whole (tobj takes it whole), and none of them past a bad line or past a byte that
+    /// no file of the format holds (NUL in text), so that a file of another kind is refused at
+    /// once, with little memory, whatever its size.
     fn read(self, input: &mut Input, path: &Path) -> Result<Mesh> {
         let bom = input.get(0, 3).len() - without_bom(input.get(0, 3)).len();
         let mesh = match self {
             Format::Ply => ply::read(input, bom, path),
-            Format::Obj | Format::Off | Format::Xyz => {
-                let prefix = input.get(0, input::PREFIX_BYTES);
-                input::refuse_binary(prefix, path)?;
-                if self == Format::Off {
-                    off::check_start(&prefix[bom..], path)?;
-                }
-                let bytes = &input.text(path)?[bom..];
-                match self {
-                    Format::Obj => obj::parse(bytes, path),
-                    Format::Off => off::parse(bytes, path),
-                    _ => xyz::parse(bytes, path),
-                }
+            Format::Off => off::read(input, bom, path),
+            Format::Xyz => xyz::read(input, bom, path),
+            Format::Obj => {
+                input::refuse_binary(input.get(0, input::PREFIX_BYTES), path)?;
+                obj::parse(&input.text(path)?[bom..], path)
             }
         }?;
         // Valid in the formats, but nothing any stage can work on, nor a mesh the C API can make.

@@ -68,10 +68,15 @@ impl fmt::Display for Position<'_> {
 /// The error every reader gives for a file with nothing but whitespace in it.
 pub(crate) fn reject_blank(bytes: &[u8], path: &Path) -> Result<(), Error> {
     if bytes.iter().all(u8::is_ascii_whitespace) {
-        Err(Error::parse(path, "line 1", "file is empty"))
+        Err(empty_file(path))
     } else {
         Ok(())
     }
+}
+
+/// The error for a file with nothing but whitespace in it.
+pub(crate) fn empty_file(path: &Path) -> Error {
+    Error::parse(path, "line 1", "file is empty")
 }
 
 #[cfg(test)]
