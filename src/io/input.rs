@@ -72,6 +72,16 @@ impl<'a> Input<'a> {
         data.get(start..end).unwrap_or_default()
     }
 
+    /// The bytes from `at` to the end of those pulled, pulling more if there are none; empty
+    /// past the end of the input.
+    #[inline]
+    pub(crate) fn available(&mut self, at: usize) -> &[u8] {
+        if at >= self.data.len() {
+            self.pull(at + 1);
+        }
+        self.data.get(at..).unwrap_or_default()
+    }
+
     /// The byte at `at`, or `None` past the end of the input.
     #[inline]
     pub(crate) fn byte(&mut self, at: usize) -> Option<u8> {

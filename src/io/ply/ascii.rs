@@ -48,11 +48,28 @@ struct Tokens<'i, 'a> {
 }
 
 impl Tokens<'_, '_> {
+    /// Moves over the bytes for which `keep` holds; returns the byte it stops at, if any.
+    #[inline]
+    fn advance(&mut self, keep: impl Fn(u8) -> bool) -> Option<u8> {
+        loop {
+            let bytes = self.input.available(self.pos);
+            if bytes.is_empty() {
+                return None;
+            }
+            match bytes.iter().position(|&b| !keep(b)) {
+                Some(at) => {
+                    let stop = bytes[at];
+                    self.pos += at;
+                    return Some(stop);
+                }
+                None => self.pos += bytes.len(),
+            }
+        }
+    }
+
     /// Skips whitespace up to, not over, the end of the line (`\r` is whitespace).
     fn skip_spaces(&mut self) {
-        while self.input.byte(self.pos).is_some_and(|b| b != b'\n' && b.is_ascii_whitespace()) {
-            self.pos += 1;
-        }
+        self.advance(|b| b != b'\n' && b.is_ascii_whitespace());
     }
 
     /// The next token on the current line, or `None` at the line's end; an error at a byte
@@ -60,15 +77,12 @@ impl Tokens<'_, '_> {
     fn next_token(&mut self) -> Result<Option<&[u8]>, Fail> {
         self.skip_spaces();
         let start = self.pos;
-        while let Some(b) = self.input.byte(self.pos).filter(|b| !b.is_ascii_whitespace()) {
-            if text::is_binary(b) {
-                return Err(Fail::Bad(format!(
-                    "byte {b:#04x}: this is binary data, but the header says `format ascii`"
-                )));
+        match self.advance(|b| !b.is_ascii_whitespace() && !text::is_binary(b)) {
+            Some(b) if text::is_binary(b) => {
+                Err(Fail::Bad(format!("byte {b:#04x}: this is binary data, but the header says `format ascii`")))
             }
-            self.pos += 1;
+            _ => Ok(Some(self.input.get(start, self.pos - start)).filter(|t| !t.is_empty())),
         }
-        Ok(Some(self.input.get(start, self.pos - start)).filter(|t| !t.is_empty()))
     }
 
     fn parse<T: std::str::FromStr>(&mut self) -> Result<T, Fail> {
