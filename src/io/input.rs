@@ -141,9 +141,9 @@ impl<'a> Input<'a> {
     }
 }
 
-/// The lines of a text input, pulled one at a time, as [`crate::io::text::lines`] splits bytes in memory:
-/// numbered from 1, without their `\n` or `\r\n`, invalid UTF-8 replaced. A NUL byte, which no
-/// text file holds, is refused at its line, before the rest of the input is pulled.
+/// The lines of a text input, pulled one at a time, as [`crate::io::text::lines`] splits
+/// bytes in memory: numbered from 1, without their `\n` or `\r\n`, invalid UTF-8 replaced. A
+/// NUL byte, which no text file holds, is refused at its line, before the rest is pulled.
 pub(crate) struct Lines {
     pos: usize,
     number: usize,
@@ -170,19 +170,22 @@ impl Lines {
             return Ok(None);
         }
         let start = self.pos;
-        // Bytes from `start` known to hold neither a line feed nor a NUL.
+        // Bytes from `start` known to hold neither a line feed nor a NUL; more are pulled
+        // only while the line is unfinished.
         let mut scanned = 0;
         let length = loop {
-            let want = (2 * scanned).max(CHUNK);
-            let bytes = input.get(start, want);
+            let bytes = match scanned {
+                0 => input.available(start),
+                _ => input.get(start, scanned + CHUNK),
+            };
             match bytes[scanned..].iter().position(|&b| b == b'\n' || b == 0) {
                 Some(at) if bytes[scanned + at] == 0 => {
                     return Err(Error::parse(path, format!("line {}", self.number + 1), NUL_BYTE));
                 }
                 Some(at) => break scanned + at,
-                None if bytes.len() < want => {
+                None if bytes.len() == scanned => {
                     self.ended = true;
-                    break bytes.len();
+                    break scanned;
                 }
                 None => scanned = bytes.len(),
             }
@@ -353,6 +356,24 @@ mod tests {
     }
 
     #[test]
+    fn pulled_lines_are_the_lines_in_memory() {
+        let long = "x".repeat(3 * CHUNK + 7);
+        for text in [format!("a\r\n{long}\r\n\nb \u{e9}\n\r\n"), format!("{long}\nlast"), String::new()] {
+            let mut bytes = text.into_bytes();
+            bytes.push(0xff);
+            let expected: Vec<(usize, String)> = crate::io::text::lines(&bytes).map(|(n, l)| (n, l.into())).collect();
+            let mut source = &bytes[..];
+            let mut input = Input::reading(&mut source, bytes.len());
+            let mut lines = Lines::new(0);
+            let mut got = Vec::new();
+            while let Some((n, line)) = lines.next(&mut input, Path::new("t")).unwrap() {
+                got.push((n, line.into_owned()));
+            }
+            assert_eq!(got, expected);
+        }
+    }
+
+    #[test]
     fn text_files_are_read_up_to_their_first_nul_byte_or_bad_line() {
         // Past the first pull: the NUL is found where the file stops being text.
         let lines = "0 0 0\n1 0 0\n0 1 0\n".repeat(10_000);
@@ -375,14 +396,14 @@ mod tests {
         // XYZ and OFF are read line by line: a bad line ends the reading.
         let (read, pulled) = read_with_tail(Format::Xyz, b"0 0 0\n1 x 0\n", b'7');
         assert_eq!(read.unwrap_err().to_string(), "t: line 2: expected a number, found `x`");
-        assert_eq!(pulled, 2 * CHUNK);
+        assert_eq!(pulled, CHUNK);
         let (read, pulled) = read_with_tail(Format::Off, b"OFF\n3 1 0\n0 0 0\n1 0 0\nx 0 0\n", b'7');
         assert_eq!(read.unwrap_err().to_string(), "t: line 5: vertex 2: expected a number, found `x`");
-        assert_eq!(pulled, 2 * CHUNK);
+        assert_eq!(pulled, CHUNK);
         // OFF is read up to its last declared face: a tail is ignored unread.
         let off = format!("OFF\n30000 0 0\n{lines}");
         let (read, pulled) = read_with_tail(Format::Off, off.as_bytes(), 0);
         assert_eq!(read.unwrap().positions.len(), 30_000);
-        assert!(pulled <= off.len() + 2 * CHUNK, "{pulled} bytes pulled for a {} byte OFF file", off.len());
+        assert!(pulled <= off.len() + CHUNK, "{pulled} bytes pulled for a {} byte OFF file", off.len());
     }
 }
