@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the fuzzers' seed inputs into fuzz/seeds/<target>/: a tetrahedron in every format
-the readers take (PLY ascii and both binary byte orders, OBJ, OFF, XYZ), and a few C-API
-inputs. Small on purpose; libFuzzer grows its working corpus under target/ from these.
+the readers take (PLY ascii and both binary byte orders, OBJ, OFF, XYZ), its PLY bodies in
+each layout of fuzz_targets/ply_header.rs, and a few C-API inputs. Small on purpose; libFuzzer grows its working corpus under target/ from these.
 Run: python3 fuzz/make_seeds.py (the output is committed)."""
 
 import math
@@ -32,6 +32,37 @@ def ply_binary(order):
     return out
 
 
+# The layouts of fuzz_targets/ply_header.rs, in its order: the coordinate type, normals,
+# colours, and the face list (count type, index type, a flag byte after it), None without faces.
+PLY_LAYOUTS = [
+    ("f", False, False, ("B", "i", False)),
+    ("f", True, False, ("B", "i", False)),
+    ("d", False, False, ("i", "i", False)),
+    ("f", False, False, None),
+    ("f", False, True, ("B", "I", True)),
+]
+
+
+def ply_body_seed(index, order):
+    """A body fuzzer's input for the tetrahedron: layout byte (plus 5 for big endian), the
+    vertex and face counts, the body; `order` is None for ASCII."""
+    coord, normals, colours, face = PLY_LAYOUTS[index]
+    vertices = [list(p) + (list(n) if normals else []) + ([200, 100, 50] if colours else [])
+                for p, n in zip(P, N)]
+    faces = [[3, *f] + ([1] if face and face[2] else []) for f in F] if face else []
+    if order is None:
+        body = "".join(" ".join("%g" % v for v in row) + "\n" for row in vertices + faces).encode()
+        selector = index
+    else:
+        vertex_format = order + coord * 3 + ("fff" if normals else "") + ("BBB" if colours else "")
+        body = b"".join(struct.pack(vertex_format, *row) for row in vertices)
+        if face:
+            face_format = order + face[0] + face[1] * 3 + ("B" if face[2] else "")
+            body += b"".join(struct.pack(face_format, *row) for row in faces)
+        selector = index + (5 if order == ">" else 0)
+    return bytes([selector, len(P), len(F)]) + body
+
+
 def seeds():
     ply_ascii = ply_header("ascii", normals=False)
     ply_ascii += "".join("%g %g %g\n" % p for p in P).encode()
@@ -47,6 +78,11 @@ def seeds():
         "obj": {"tetra.obj": obj.encode()},
         "off": {"tetra.off": off.encode()},
         "xyz": {"tetra.xyz": xyz.encode(), "points.xyz": b"0 0 0\n1 0 0\n0 1 0\n"},
+    }
+    files["ply_ascii_body"] = {"layout%d" % i: ply_body_seed(i, None) for i in range(len(PLY_LAYOUTS))}
+    files["ply_binary_body"] = {
+        "layout%d_%s" % (i, name): ply_body_seed(i, order)
+        for i in range(len(PLY_LAYOUTS)) for order, name in (("<", "le"), (">", "be"))
     }
     # capi_load: a selector byte (0 ply, 1 obj, 2 off, 3 xyz) then the file.
     files["capi_load"] = {

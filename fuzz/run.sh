@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Bounded fuzzing run of every target in fuzz/ (cargo-fuzz: libFuzzer + AddressSanitizer):
-# the PLY/OBJ/OFF/XYZ readers and the C API entry points, each for a few seconds from the
-# committed seeds (fuzz/seeds, made by fuzz/make_seeds.py). Any crash, sanitizer report,
+# the PLY/OBJ/OFF/XYZ readers, the PLY reader's ASCII and binary bodies behind realistic
+# headers (fuzz_targets/ply_header.rs) and the C API entry points, each for a few seconds
+# from the committed seeds (fuzz/seeds, made by fuzz/make_seeds.py). Any crash, sanitizer report,
 # panic, or VSTREE_STATUS_INTERNAL from the C API fails the run; the input is kept under
 # target/fuzz-artifacts/<target>/ for reproduction:
 #   RUSTC_BOOTSTRAP=1 cargo fuzz run --fuzz-dir fuzz --target-dir target/fuzz <target> <artifact>
@@ -27,7 +28,7 @@ build_options=(--fuzz-dir fuzz --target-dir "$target_dir" --codegen-units 16)
 echo "-- building the fuzz targets"
 cargo fuzz build "${build_options[@]}"
 
-for target in ply obj off xyz capi_load capi_arrays; do
+for target in ply ply_ascii_body ply_binary_body obj off xyz capi_load capi_arrays; do
     corpus="target/fuzz-corpus/$target"
     artifacts="target/fuzz-artifacts/$target/"
     mkdir -p "$corpus" "$artifacts"

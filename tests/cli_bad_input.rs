@@ -496,6 +496,48 @@ fn cases() -> Vec<Case> {
     long.creates = Some(long_name);
     cases.push(long);
     cases.extend(flag_cases());
+    // A PLY is read up to the end of the elements its header declares: a body of another kind
+    // is refused at its first byte, named (never copied into the message), and a tail after
+    // the elements is ignored.
+    let mut nul_body =
+        b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+            .to_vec();
+    nul_body.extend([0; 4096]);
+    cases.push(fail(
+        "ASCII PLY header then NUL bytes",
+        vec![file("n.ply", Entry::Bytes(nul_body))],
+        &["stats", "n.ply"],
+        error("n.ply: line 8: vertex 0: byte 0x00: this is binary data, but the header says `format ascii`"),
+    ));
+    let mut tail = binary_ply.clone();
+    tail.extend([0; 4096]);
+    cases.push(Case {
+        quiet_stdout: false,
+        code: 0,
+        ..fail(
+            "binary PLY with a tail after its elements",
+            vec![file("tail.ply", Entry::Bytes(tail))],
+            &["stats", "tail.ply", "-q"],
+            exact(""),
+        )
+    });
+    cases.push(fail(
+        "OBJ with an escape sequence for a number",
+        vec![text("e.obj", "v 0 0 0\nv 1 \x1b[2J 0\n")],
+        &["stats", "e.obj"],
+        error("e.obj: line 2: expected a number, found `\\u{1b}[2J`"),
+    ));
+    // Vertex colours are not used, so colours on some vertices only are no error.
+    cases.push(Case {
+        quiet_stdout: false,
+        code: 0,
+        ..fail(
+            "OBJ with colours on some vertices",
+            vec![text("c.obj", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")],
+            &["stats", "c.obj", "-q"],
+            exact(""),
+        )
+    });
     cases
 }
 

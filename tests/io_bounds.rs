@@ -1,6 +1,8 @@
 //! Reading has bounds: a file that is not what its extension says fails at once, with little
-//! memory, whatever its size; devices and FIFOs are refused without blocking. Measured on the
-//! CLI in a child process, whose peak memory the kernel reports (`wait4`).
+//! memory, whatever its size; devices and FIFOs are refused without blocking; a PLY file is
+//! read up to the end of the elements its header declares, and no further. Measured on the
+//! CLI in a child process, whose peak memory the kernel reports (`wait4`), and in this
+//! process by an allocator that keeps the peak of the bytes allocated.
 
 #![cfg(unix)]
 
@@ -12,7 +14,42 @@ use std::io::Read;
 use std::os::unix::fs::symlink;
 use std::path::Path;
 use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
+
+/// The system allocator, counting the bytes allocated now and their peak.
+struct Counting;
+
+static ALLOCATED: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: every call is passed on to the system allocator unchanged; only counts are added.
+unsafe impl std::alloc::GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        let p = std::alloc::System.alloc(layout);
+        if !p.is_null() {
+            let now = ALLOCATED.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+            PEAK.fetch_max(now, Ordering::Relaxed);
+        }
+        p
+    }
+
+    unsafe fn dealloc(&self, p: *mut u8, layout: std::alloc::Layout) {
+        std::alloc::System.dealloc(p, layout);
+        ALLOCATED.fetch_sub(layout.size(), Ordering::Relaxed);
+    }
+}
+
+#[global_allocator]
+static COUNTING: Counting = Counting;
+
+/// What `f` returns, and the most bytes allocated meanwhile beyond those allocated before.
+fn peak_allocation<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    let before = ALLOCATED.load(Ordering::Relaxed);
+    PEAK.store(before, Ordering::Relaxed);
+    let result = f();
+    (result, PEAK.load(Ordering::Relaxed).saturating_sub(before))
+}
 
 /// What a run of the CLI gave: exit code, stderr, wall time, peak resident memory in bytes.
 struct Run {
@@ -119,4 +156,33 @@ fn devices_and_fifos_are_refused_without_blocking() {
         }
     }
     assert!(!output.exists());
+}
+
+#[test]
+fn a_ply_file_is_read_up_to_its_declared_elements_whatever_follows() {
+    let scratch = Scratch::new("bounds-tail");
+    let mesh = vstree::eval::shapes::icosphere(1.0, 4);
+    let tail = 2u64 << 30;
+    // A complete binary PLY followed by 2 GiB of zeros (sparse: nothing is written to disk):
+    // read, and the tail ignored without being read.
+    let binary = scratch.0.join("tail.ply");
+    vstree::io::write(&binary, &mesh).unwrap();
+    let file = fs::OpenOptions::new().write(true).open(&binary).unwrap();
+    file.set_len(file.metadata().unwrap().len() + tail).unwrap();
+    let (read, peak) = peak_allocation(|| vstree::io::read(&binary));
+    assert_eq!(read.unwrap(), mesh);
+    assert!(peak < 16 << 20, "peak allocation {} MB for a 1 MB mesh", peak >> 20);
+    // An ASCII header followed by 2 GiB of zeros: refused at the first byte of the body.
+    let ascii = scratch.0.join("zeros.ply");
+    let header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                  property float z\nend_header\n";
+    fs::write(&ascii, header).unwrap();
+    fs::OpenOptions::new().write(true).open(&ascii).unwrap().set_len(header.len() as u64 + tail).unwrap();
+    let (read, peak) = peak_allocation(|| vstree::io::read(&ascii));
+    let expected = format!(
+        "{}: line 8: vertex 0: byte 0x00: this is binary data, but the header says `format ascii`",
+        ascii.display()
+    );
+    assert_eq!(read.unwrap_err().to_string(), expected);
+    assert!(peak < 16 << 20, "peak allocation {} MB for a file refused at line 8", peak >> 20);
 }

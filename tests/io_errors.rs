@@ -1,6 +1,7 @@
 //! Malformed input gives an error that names the file, the place and the problem, and no
 //! input bytes at all make a reader panic.
 
+use glam::Vec3;
 use std::path::Path;
 use std::time::{Duration, Instant};
 use vstree::io;
@@ -316,8 +317,28 @@ fn obj_errors_name_the_line() {
     io::obj::parse(format!("{tri}p 99\nl 5 6\nf 1 2 3\n").as_bytes(), Path::new("ok.obj")).unwrap();
     expect_at(obj(&format!("{tri}f 1 2 3\nf 1 2\n")), "line 5", "a face with 2 corners: a face needs at least 3");
     expect_at(obj(&format!("{tri}f 1 # two\n")), "line 4", "a face with 1 corner: ");
-    // A forward reference across objects fails in tobj but not in the scan: whole-file location.
-    expect_at(obj("o a\nv 0 0 0\nv 1 0 0\nf 1 2 3\no b\nv 0 1 0\n"), "OBJ data", "out of bounds");
+    // A reference to a `v` line after the end of the face's object, which tobj refuses.
+    expect_at(
+        obj("o a\nv 0 0 0\nv 1 0 0\nf 1 2 3\no b\nv 0 1 0\n"),
+        "line 4",
+        "vertex index 3 is out of range: its object ends at line 5 after 2 `v` lines, and a face may only use those",
+    );
+    expect_at(
+        obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//2\nvn 0 0 1\ng b\nvn 0 0 1\n"),
+        "line 4",
+        "normal index 2 is out of range: its object ends at line 6 after 1 `vn` lines",
+    );
+}
+
+#[test]
+fn obj_colours_on_some_vertices_are_ignored() {
+    // tobj looks colours up by vertex and failed here with "face vertex color index out of bounds".
+    let src = "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    let mesh = io::obj::parse(src.as_bytes(), Path::new("c.obj")).unwrap();
+    assert_eq!(mesh.positions, [Vec3::ZERO, Vec3::Y, Vec3::X, Vec3::Z]);
+    assert_eq!(mesh.triangles, [[0, 1, 2], [0, 2, 3], [0, 3, 1], [2, 1, 3]]);
+    // Malformed colours are still errors at their line.
+    expect_at(obj("v 0 0 0 1 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "line 1", "expected x y z, x y z w or x y z r g b");
 }
 
 #[test]

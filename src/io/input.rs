@@ -1,34 +1,205 @@
 //! Reading an input file with bounds: only regular files are read (a device, a FIFO or a
 //! socket could be endless or block forever), never more than the size the file had when it
-//! was opened, and the first [`PREFIX_BYTES`] are checked against the format before the rest
-//! is read, so a file of another kind fails at once and with little memory whatever its size.
+//! was opened, and only as far as the reader gets: [`Input`] pulls bytes from the file as the
+//! reader asks for them, so a reader that stops (at the end of the elements a PLY header
+//! declares, or at a byte no file of its format holds) leaves the rest of the file unread.
 
-use super::Format;
 use crate::error::{Error, Result};
+use std::borrow::Cow;
 use std::fs::{File, Metadata, OpenOptions};
 use std::io::{self, Read};
+use std::ops::Range;
 use std::path::Path;
 
 /// Bytes read and checked before the rest of a file: enough for any real PLY header and for
 /// many lines of a text format, little enough to be instant.
 pub(crate) const PREFIX_BYTES: usize = 64 * 1024;
 
-/// The whole content of the regular file at `path`, once its start looks like `format`.
-pub(crate) fn read(path: &Path, format: Format) -> Result<Vec<u8>> {
+/// The least an [`Input`] reads from its source at a time, so that readers asking for a few
+/// bytes at a time do not make a system call each. Reading stops at most this far past the
+/// last byte a reader asked for.
+const CHUNK: usize = 64 * 1024;
+
+/// Runs `read` on the bytes of the regular file at `path`, pulled from the file as `read` asks
+/// for them; an error reading the file, or a file that grows meanwhile, is reported instead of
+/// what `read` returns.
+pub(crate) fn read<T>(path: &Path, read: impl FnOnce(&mut Input) -> Result<T>) -> Result<T> {
     let io_error = |e| Error::io(path, e);
     let (file, size) = open_regular(path).map_err(io_error)?;
     let size = usize::try_from(size).map_err(|_| Error::TooLarge(format!("{}: {size} bytes", path.display())))?;
     // One byte more than the size, to notice a file that grows while it is read.
-    let mut reader = file.take(size as u64 + 1);
-    let mut bytes = Vec::with_capacity(size.min(PREFIX_BYTES));
-    (&mut reader).take(PREFIX_BYTES as u64).read_to_end(&mut bytes).map_err(io_error)?;
-    format.check_start(&bytes, bytes.len() < size, path)?;
-    bytes.reserve_exact(size.saturating_sub(bytes.len()));
-    reader.read_to_end(&mut bytes).map_err(io_error)?;
-    if bytes.len() > size {
+    let mut source = file.take(size as u64 + 1);
+    let mut input = Input::reading(&mut source, size);
+    let result = read(&mut input);
+    if let Some(e) = input.failed.take() {
+        return Err(io_error(e));
+    }
+    if input.data.len() > size {
         return Err(io_error(io::Error::other("the file grew while it was read: read it once it is complete")));
     }
-    Ok(bytes)
+    result
+}
+
+/// The bytes of an input, in memory or pulled from a source as a reader asks for them.
+/// Positions are from the start of the input; what has been pulled stays in memory.
+pub(crate) struct Input<'a> {
+    data: Cow<'a, [u8]>,
+    /// Where more bytes come from; `None` once it has ended or failed, or for bytes in memory.
+    source: Option<&'a mut dyn Read>,
+    /// The input's whole size as far as it is known (a file's size when it was opened), which
+    /// bounds what a reader reserves room for.
+    size: usize,
+    /// The error that ended the source, reported by [`read`].
+    failed: Option<io::Error>,
+}
+
+impl<'a> Input<'a> {
+    /// An input whose bytes are all in memory.
+    pub(crate) fn memory(bytes: &'a [u8]) -> Input<'a> {
+        Input { data: Cow::Borrowed(bytes), source: None, size: bytes.len(), failed: None }
+    }
+
+    /// An input read from `source`, which holds about `size` bytes.
+    pub(crate) fn reading(source: &'a mut dyn Read, size: usize) -> Input<'a> {
+        Input { data: Cow::Owned(Vec::new()), source: Some(source), size, failed: None }
+    }
+
+    /// The bytes from `start` on, at least `n` of them unless the input ends before.
+    pub(crate) fn get(&mut self, start: usize, n: usize) -> &[u8] {
+        self.pull(start.saturating_add(n));
+        let data = &*self.data;
+        let end = start.saturating_add(n).min(data.len());
+        data.get(start..end).unwrap_or_default()
+    }
+
+    /// The bytes from `at` to the end of those pulled, pulling more if there are none; empty
+    /// past the end of the input.
+    #[inline]
+    pub(crate) fn available(&mut self, at: usize) -> &[u8] {
+        if at >= self.data.len() {
+            self.pull(at + 1);
+        }
+        self.data.get(at..).unwrap_or_default()
+    }
+
+    /// The byte at `at`, or `None` past the end of the input.
+    #[inline]
+    pub(crate) fn byte(&mut self, at: usize) -> Option<u8> {
+        if at >= self.data.len() {
+            self.pull(at + 1);
+        }
+        self.data.get(at).copied()
+    }
+
+    /// The bytes pulled so far (all of them for an input in memory).
+    pub(crate) fn pulled(&self) -> &[u8] {
+        &self.data
+    }
+
+    /// Bytes from `at` to the end of the input as far as its size is known.
+    pub(crate) fn remaining(&self, at: usize) -> usize {
+        self.size.max(self.data.len()).saturating_sub(at)
+    }
+
+    /// Reads from the source until `end` bytes are in memory or the source ends, at least
+    /// [`CHUNK`] bytes at a time.
+    fn pull(&mut self, end: usize) {
+        let have = self.data.len();
+        let Some(source) = self.source.as_mut().filter(|_| end > have) else {
+            return;
+        };
+        let want = (end - have).max(CHUNK);
+        let bytes = self.data.to_mut();
+        // Room grows geometrically (pulls are small), but never past the size of the input.
+        let room = want.max(have).min(self.size.saturating_sub(have) + 1);
+        bytes.reserve_exact(room);
+        match source.take(want as u64).read_to_end(bytes) {
+            Ok(got) if got == want => {}
+            Ok(_) => self.source = None,
+            Err(e) => {
+                self.failed = Some(e);
+                self.source = None;
+            }
+        }
+    }
+
+    /// Pulls the rest of a text file and returns all of it, refusing the first NUL byte:
+    /// none is in a text file, and pulling stops there.
+    pub(crate) fn text(&mut self, path: &Path) -> Result<&[u8]> {
+        let mut checked = 0;
+        loop {
+            let end = self.data.len();
+            if let Some(at) = self.data[checked..].iter().position(|&b| b == 0) {
+                return Err(nul_error(&self.data[..checked + at], path));
+            }
+            checked = end;
+            self.pull(end + CHUNK);
+            if self.data.len() == end {
+                return Ok(&self.data);
+            }
+        }
+    }
+}
+
+/// The lines of a text input, pulled one at a time, as [`crate::io::text::lines`] splits
+/// bytes in memory: numbered from 1, without their `\n` or `\r\n`, invalid UTF-8 replaced. A
+/// NUL byte, which no text file holds, is refused at its line, before the rest is pulled.
+pub(crate) struct Lines {
+    pos: usize,
+    number: usize,
+    ended: bool,
+}
+
+impl Lines {
+    /// The lines from byte `start` on.
+    pub(crate) fn new(start: usize) -> Lines {
+        Lines { pos: start, number: 0, ended: false }
+    }
+
+    /// The next line, or `None` after the last (which is empty when the input ends with `\n`).
+    pub(crate) fn next<'i>(&mut self, input: &'i mut Input, path: &Path) -> Result<Option<(usize, Cow<'i, str>)>> {
+        let Some((number, range)) = self.next_range(input, path)? else {
+            return Ok(None);
+        };
+        Ok(Some((number, Lines::text(input, range))))
+    }
+
+    /// The number of the next line and where its bytes are in `input`, or `None` after the last.
+    pub(crate) fn next_range(&mut self, input: &mut Input, path: &Path) -> Result<Option<(usize, Range<usize>)>> {
+        if self.ended {
+            return Ok(None);
+        }
+        let start = self.pos;
+        // Bytes from `start` known to hold neither a line feed nor a NUL; more are pulled
+        // only while the line is unfinished.
+        let mut scanned = 0;
+        let length = loop {
+            let bytes = match scanned {
+                0 => input.available(start),
+                _ => input.get(start, scanned + CHUNK),
+            };
+            match bytes[scanned..].iter().position(|&b| b == b'\n' || b == 0) {
+                Some(at) if bytes[scanned + at] == 0 => {
+                    return Err(Error::parse(path, format!("line {}", self.number + 1), NUL_BYTE));
+                }
+                Some(at) => break scanned + at,
+                None if bytes.len() == scanned => {
+                    self.ended = true;
+                    break scanned;
+                }
+                None => scanned = bytes.len(),
+            }
+        };
+        self.number += 1;
+        self.pos = start + length + 1;
+        Ok(Some((self.number, start..start + length)))
+    }
+
+    /// The text of the line at `range` (from [`Lines::next_range`]), without a final `\r`.
+    pub(crate) fn text<'i>(input: &'i Input, range: Range<usize>) -> Cow<'i, str> {
+        let line = input.pulled().get(range).unwrap_or_default();
+        String::from_utf8_lossy(line.strip_suffix(b"\r").unwrap_or(line))
+    }
 }
 
 /// Opens `path` for reading if it is a regular file (links followed), with its size.
@@ -92,9 +263,147 @@ pub(crate) fn file_kind(metadata: &Metadata) -> &'static str {
 /// The error for text data holding a NUL byte, which no text format has: the file is binary
 /// (or zeros), so it is refused at the first one instead of being read whole.
 pub(crate) fn refuse_binary(bytes: &[u8], path: &Path) -> Result<()> {
-    let Some(at) = bytes.iter().position(|&b| b == 0) else {
-        return Ok(());
-    };
-    let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
-    Err(Error::parse(path, format!("line {line}"), "a NUL byte: this is binary data, not a text file"))
+    match bytes.iter().position(|&b| b == 0) {
+        Some(at) => Err(nul_error(&bytes[..at], path)),
+        None => Ok(()),
+    }
+}
+
+/// The error for a NUL byte that follows `before`.
+fn nul_error(before: &[u8], path: &Path) -> Error {
+    let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
+    Error::parse(path, format!("line {line}"), NUL_BYTE)
+}
+
+const NUL_BYTE: &str = "a NUL byte: this is binary data, not a text file";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::{ply, Format};
+    use crate::mesh::Mesh;
+
+    /// A source that counts the bytes pulled from it.
+    struct Counting<R> {
+        inner: R,
+        pulled: usize,
+    }
+
+    impl<R: Read> Read for Counting<R> {
+        fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            let n = self.inner.read(buf)?;
+            self.pulled += n;
+            Ok(n)
+        }
+    }
+
+    const TAIL: u64 = 2 << 30;
+
+    /// Reads `file` followed by 2 GiB of `tail_byte` (generated, never in memory) as `format`;
+    /// returns the result and how many bytes were pulled from the source.
+    fn read_with_tail(format: Format, file: &[u8], tail_byte: u8) -> (Result<Mesh>, usize) {
+        let size = file.len() + TAIL as usize;
+        let mut source = Counting { inner: file.chain(io::repeat(tail_byte).take(TAIL)), pulled: 0 };
+        let result = format.read(&mut Input::reading(&mut source, size), Path::new("t"));
+        (result, source.pulled)
+    }
+
+    fn ply_bytes(mesh: &Mesh, ascii: bool) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        ply::write(&mut bytes, mesh, ascii).unwrap();
+        bytes
+    }
+
+    #[test]
+    fn a_ply_is_read_up_to_its_declared_elements_and_a_tail_is_ignored_unread() {
+        // 10242 vertices and 20480 faces: bodies well beyond the first pull.
+        let mesh = crate::eval::shapes::icosphere(1.0, 5);
+        for ascii in [false, true] {
+            let file = ply_bytes(&mesh, ascii);
+            for tail_byte in [0, b'7', b'\n'] {
+                let (read, pulled) = read_with_tail(Format::Ply, &file, tail_byte);
+                assert_eq!(read.unwrap(), mesh, "ascii {ascii}, tail {tail_byte}");
+                assert!(
+                    pulled <= file.len() + CHUNK,
+                    "ascii {ascii}: {pulled} bytes pulled for a {} byte file",
+                    file.len()
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn an_ascii_ply_body_of_nul_bytes_is_refused_at_its_first_byte() {
+        let header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                      property float z\nend_header\n";
+        let (read, pulled) = read_with_tail(Format::Ply, header.as_bytes(), 0);
+        let message = read.unwrap_err().to_string();
+        assert_eq!(message, "t: line 8: vertex 0: byte 0x00: this is binary data, but the header says `format ascii`");
+        assert_eq!(pulled, PREFIX_BYTES);
+        // The same one line on: a control byte inside a number.
+        let (read, pulled) = read_with_tail(Format::Ply, format!("{header}0 0 0\n1 \x1b").as_bytes(), b'2');
+        let message = read.unwrap_err().to_string();
+        assert_eq!(message, "t: line 9: vertex 1: byte 0x1b: this is binary data, but the header says `format ascii`");
+        assert_eq!(pulled, PREFIX_BYTES);
+    }
+
+    #[test]
+    fn a_ply_header_of_binary_bytes_is_refused_at_its_line() {
+        let (read, pulled) = read_with_tail(Format::Ply, b"ply\nformat ascii 1.0\n", 0);
+        let message = read.unwrap_err().to_string();
+        assert_eq!(message, "t: line 3: byte 0x00: this is binary data, but a PLY header is text");
+        assert_eq!(pulled, PREFIX_BYTES);
+    }
+
+    #[test]
+    fn pulled_lines_are_the_lines_in_memory() {
+        let long = "x".repeat(3 * CHUNK + 7);
+        for text in [format!("a\r\n{long}\r\n\nb \u{e9}\n\r\n"), format!("{long}\nlast"), String::new()] {
+            let mut bytes = text.into_bytes();
+            bytes.push(0xff);
+            let expected: Vec<(usize, String)> = crate::io::text::lines(&bytes).map(|(n, l)| (n, l.into())).collect();
+            let mut source = &bytes[..];
+            let mut input = Input::reading(&mut source, bytes.len());
+            let mut lines = Lines::new(0);
+            let mut got = Vec::new();
+            while let Some((n, line)) = lines.next(&mut input, Path::new("t")).unwrap() {
+                got.push((n, line.into_owned()));
+            }
+            assert_eq!(got, expected);
+        }
+    }
+
+    #[test]
+    fn text_files_are_read_up_to_their_first_nul_byte_or_bad_line() {
+        // Past the first pull: the NUL is found where the file stops being text.
+        let lines = "0 0 0\n1 0 0\n0 1 0\n".repeat(10_000);
+        let obj: String = lines.lines().map(|l| format!("v {l}\n")).collect();
+        for (format, file) in [(Format::Xyz, &lines), (Format::Obj, &obj)] {
+            let (read, pulled) = read_with_tail(format, file.as_bytes(), 0);
+            let line = file.lines().count() + 1;
+            let message = read.unwrap_err().to_string();
+            assert_eq!(
+                message,
+                format!("t: line {line}: a NUL byte: this is binary data, not a text file"),
+                "{format:?}"
+            );
+            assert!(
+                pulled <= file.len() + 2 * CHUNK,
+                "{format:?}: {pulled} bytes pulled for {} bytes of text",
+                file.len()
+            );
+        }
+        // XYZ and OFF are read line by line: a bad line ends the reading.
+        let (read, pulled) = read_with_tail(Format::Xyz, b"0 0 0\n1 x 0\n", b'7');
+        assert_eq!(read.unwrap_err().to_string(), "t: line 2: expected a number, found `x`");
+        assert_eq!(pulled, CHUNK);
+        let (read, pulled) = read_with_tail(Format::Off, b"OFF\n3 1 0\n0 0 0\n1 0 0\nx 0 0\n", b'7');
+        assert_eq!(read.unwrap_err().to_string(), "t: line 5: vertex 2: expected a number, found `x`");
+        assert_eq!(pulled, CHUNK);
+        // OFF is read up to its last declared face: a tail is ignored unread.
+        let off = format!("OFF\n30000 0 0\n{lines}");
+        let (read, pulled) = read_with_tail(Format::Off, off.as_bytes(), 0);
+        assert_eq!(read.unwrap().positions.len(), 30_000);
+        assert!(pulled <= off.len() + CHUNK, "{pulled} bytes pulled for a {} byte OFF file", off.len());
+    }
 }

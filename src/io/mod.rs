@@ -20,6 +20,7 @@ pub use cleanup::remove_temporary_files_on_signals;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use input::Input;
 use std::path::Path;
 
 /// A file format vstree reads and writes.
@@ -51,15 +52,24 @@ impl Format {
     /// Parses a whole file of this format held in memory; `path` is used only in messages.
     /// A UTF-8 byte order mark at the start is skipped (editors on Windows write one).
     pub fn parse(self, bytes: &[u8], path: &Path) -> Result<Mesh> {
-        let bytes = without_bom(bytes);
-        if self != Format::Ply {
-            input::refuse_binary(bytes.get(..input::PREFIX_BYTES).unwrap_or(bytes), path)?;
-        }
+        self.read(&mut Input::memory(bytes), path)
+    }
+
+    /// Reads a file of this format from `input`, pulling only what the reader needs: a PLY or
+    /// OFF file up to the end of the elements it declares, an XYZ file line by line, an OBJ
+    /// file whole (tobj takes it whole), and none of them past a bad line or past a byte that
+    /// no file of the format holds (NUL in text), so that a file of another kind is refused at
+    /// once, with little memory, whatever its size.
+    fn read(self, input: &mut Input, path: &Path) -> Result<Mesh> {
+        let bom = input.get(0, 3).len() - without_bom(input.get(0, 3)).len();
         let mesh = match self {
-            Format::Ply => ply::parse(bytes, path),
-            Format::Obj => obj::parse(bytes, path),
-            Format::Off => off::parse(bytes, path),
-            Format::Xyz => xyz::parse(bytes, path),
+            Format::Ply => ply::read(input, bom, path),
+            Format::Off => off::read(input, bom, path),
+            Format::Xyz => xyz::read(input, bom, path),
+            Format::Obj => {
+                input::refuse_binary(input.get(0, input::PREFIX_BYTES), path)?;
+                obj::parse(&input.text(path)?[bom..], path)
+            }
         }?;
         // Valid in the formats, but nothing any stage can work on, nor a mesh the C API can make.
         if mesh.positions.is_empty() {
@@ -69,21 +79,6 @@ impl Format {
             )));
         }
         Ok(mesh)
-    }
-
-    /// Checks the first bytes of a file before the rest is read, so that a file of another
-    /// kind is refused at once: a PLY header (when `prefix` holds all of it), the OFF keyword,
-    /// no NUL byte in a text format. `more` says that the file goes on after `prefix`.
-    fn check_start(self, prefix: &[u8], more: bool, path: &Path) -> Result<()> {
-        let prefix = without_bom(prefix);
-        match self {
-            Format::Ply => match ply::check_header(prefix, path) {
-                Err(Error::Parse { location, .. }) if more && location == ply::UNFINISHED_HEADER => Ok(()),
-                result => result,
-            },
-            Format::Off => input::refuse_binary(prefix, path).and_then(|()| off::check_start(prefix, path)),
-            Format::Obj | Format::Xyz => input::refuse_binary(prefix, path),
-        }
     }
 }
 
@@ -101,8 +96,7 @@ pub struct WriteOptions {
 /// Reads the mesh or point cloud at `path`, in the format its extension names.
 pub fn read(path: &Path) -> Result<Mesh> {
     let format = format_of(path)?;
-    let bytes = input::read(path, format)?;
-    format.parse(&bytes, path)
+    input::read(path, |input| format.read(input, path))
 }
 
 /// Writes `mesh` to `path` with default options (PLY as binary little-endian).

@@ -1,9 +1,11 @@
 //! Wavefront OBJ through `tobj`, keeping position indexing (no per-corner vertex splitting).
 //!
-//! Polygons are fan-triangulated by tobj; points and lines (`p`, `l`) are ignored, and an `f`
-//! with fewer than three corners is an error, as in the other formats. tobj numbers vertices in order of first use by a face and drops the ones
-//! no face uses; a file with no faces is read as a point cloud of all its `v` lines. Normals are
-//! kept only when they are per-vertex: as many normals as positions, indexed like them.
+//! Polygons are fan-triangulated by tobj; points and lines (`p`, `l`) are ignored, as are
+//! vertex colours (`v x y z r g b`, on all vertices or some), and an `f` with fewer than three
+//! corners is an error, as in the other formats. tobj numbers vertices in order of first use
+//! by a face and drops the ones no face uses; a file with no faces is read as a point cloud of
+//! all its `v` lines. Normals are kept only when they are per-vertex: as many normals as
+//! positions, indexed like them.
 //! Positions, and normals when kept, must be finite.
 //!
 //! tobj reports no line numbers, so when it fails the source is scanned again ([`scan`]) to
@@ -42,9 +44,17 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         ..Default::default()
     };
     // tobj can overflow (and so panic, with overflow checks) on absurd relative indices.
-    let loaded = panic::catch_unwind(AssertUnwindSafe(|| {
-        tobj::load_obj_buf(&mut source.as_bytes(), &options, |_| Ok(Default::default()))
-    }));
+    let load = |source: &str| {
+        panic::catch_unwind(AssertUnwindSafe(|| {
+            tobj::load_obj_buf(&mut source.as_bytes(), &options, |_| Ok(Default::default()))
+        }))
+    };
+    let mut loaded = load(&source);
+    // tobj looks colours up by vertex, so colours on some `v` lines only make it fail; they are
+    // not used, so the file is read again without them.
+    if matches!(loaded, Ok(Err(tobj::LoadError::FaceColorOutOfBounds))) {
+        loaded = load(&scan::without_colours(&source));
+    }
     let models = match loaded {
         Ok(Ok((models, _materials))) => models,
         Ok(Err(e)) => return Err(rejected(&source, path, e.to_string())),
@@ -202,6 +212,13 @@ mod tests {
         assert_eq!(m.positions.len(), 6);
         assert_eq!(m.triangles, vec![[0, 1, 2], [3, 4, 5]]);
         assert_eq!(m.positions[3], Vec3::Z);
+    }
+
+    #[test]
+    fn colours_on_some_vertices_are_ignored() {
+        let m = parse_str("v 0 0 0 1 0 0\nv 1 0 0\nv 1 1 0 0 0 1\nv 0 1 0\nf 1 2 3\nf 1 3 4\n").unwrap();
+        assert_eq!(m.positions, vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y]);
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! normals.
 
 use crate::error::{Error, Result};
+use crate::io::input::{Input, Lines};
 use crate::io::{assemble, text};
 use crate::mesh::Mesh;
 use glam::DVec3;
@@ -14,37 +15,35 @@ use std::path::Path;
 
 /// Parses a whole OFF file held in memory. `path` is used only in error messages.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
-    text::reject_blank(bytes, path)?;
-    let mut lines = content_lines(bytes);
-    let mut last_line = 1;
-    let mut next = |what: &dyn Fn() -> String| match lines.next() {
-        Some((n, line)) => {
-            last_line = n;
-            Ok((n, line))
-        }
-        None => Err(Error::parse(path, format!("line {last_line}"), what())),
-    };
+    read(&mut Input::memory(bytes), 0, path)
+}
+
+/// Reads the OFF file that starts at byte `start` of `input`, pulling it line by line up to
+/// its last declared face: reading stops at the first bad line, and what follows the faces
+/// is not read.
+pub(crate) fn read(input: &mut Input, start: usize, path: &Path) -> Result<Mesh> {
+    let mut lines = Content { lines: Lines::new(start), last: 1, blank: true };
     let at = |n: usize, message: String| Error::parse(path, format!("line {n}"), message);
 
-    let (n, first) = next(&|| "file ends before the OFF keyword".into())?;
+    let (n, first) = lines.next(input, path, || "file ends before the OFF keyword".into())?;
     let mut words = first.split_whitespace();
     let keyword = words.next().unwrap_or_default();
     let has_normals = parse_keyword(keyword).map_err(|m| at(n, m))?;
     let mut counts: Vec<String> = words.map(str::to_owned).collect();
     let mut counts_line = n;
     if counts.is_empty() {
-        let (n, line) = next(&|| "file ends before the vertex and face counts".into())?;
+        let (n, line) = lines.next(input, path, || "file ends before the vertex and face counts".into())?;
         counts = line.split_whitespace().map(str::to_owned).collect();
         counts_line = n;
     }
     let (vertex_count, face_count) = parse_counts(&counts).map_err(|m| at(counts_line, m))?;
     assemble::vertex_count_fits(vertex_count).map_err(|m| Error::TooLarge(format!("{}: {m}", path.display())))?;
 
-    let mut positions = Vec::with_capacity(assemble::capacity(vertex_count, bytes.len(), 6));
+    let mut positions = Vec::with_capacity(assemble::capacity(vertex_count, input.remaining(start), 6));
     let mut normals = has_normals.then(|| Vec::with_capacity(positions.capacity()));
     let columns = if has_normals { 6 } else { 3 };
     for i in 0..vertex_count {
-        let (n, line) = next(&|| format!("file ends after {i} of the {vertex_count} vertices"))?;
+        let (n, line) = lines.next(input, path, || format!("file ends after {i} of the {vertex_count} vertices"))?;
         let values = numbers(&line, columns).map_err(|m| at(n, format!("vertex {i}: {m}")))?;
         let p = DVec3::new(values[0], values[1], values[2]);
         positions.push(assemble::finite_position(p).map_err(|m| at(n, format!("vertex {i}: {m}")))?);
@@ -54,10 +53,10 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
         }
     }
 
-    let mut triangles = Vec::with_capacity(assemble::capacity(face_count, bytes.len(), 8));
+    let mut triangles = Vec::with_capacity(assemble::capacity(face_count, input.remaining(start), 8));
     let mut polygon = Vec::new();
     for i in 0..face_count {
-        let (n, line) = next(&|| format!("file ends after {i} of the {face_count} faces"))?;
+        let (n, line) = lines.next(input, path, || format!("file ends after {i} of the {face_count} faces"))?;
         read_face(&line, vertex_count, &mut polygon)
             .and_then(|()| assemble::push_fan(&polygon, &mut triangles))
             .map_err(|m| at(n, format!("face {i}: {m}")))?;
@@ -65,26 +64,43 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
     Ok(assemble::mesh(positions, normals, triangles))
 }
 
-/// Checks the start of a file before it is read whole: the first content line, when `prefix`
-/// holds all of it, must begin with the OFF keyword.
-pub(crate) fn check_start(prefix: &[u8], path: &Path) -> Result<()> {
-    let complete = &prefix[..prefix.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1)];
-    if let Some((n, line)) = content_lines(complete).next() {
-        parse_keyword(line.split_whitespace().next().unwrap_or_default())
-            .map_err(|m| Error::parse(path, format!("line {n}"), m))?;
-    }
-    Ok(())
+/// The content lines of an OFF input, pulled one at a time: comments removed, blank lines
+/// skipped.
+struct Content {
+    lines: Lines,
+    /// The last content line, where an early end is reported.
+    last: usize,
+    /// Whether every line so far is whitespace only.
+    blank: bool,
 }
 
-/// Lines with comments removed, skipping those left blank.
-fn content_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, Cow<'_, str>)> {
-    text::lines(bytes).filter_map(|(n, line)| {
-        let content = match line.find('#') {
-            Some(hash) => Cow::Owned(line[..hash].to_owned()),
-            None => line,
-        };
-        (!content.trim().is_empty()).then_some((n, content))
-    })
+impl Content {
+    /// The next content line; at the end, an error saying `what` is missing (or that the file
+    /// is empty, when it holds nothing but whitespace).
+    fn next<'i>(
+        &mut self,
+        input: &'i mut Input,
+        path: &Path,
+        what: impl Fn() -> String,
+    ) -> Result<(usize, Cow<'i, str>)> {
+        while let Some((n, range)) = self.lines.next_range(input, path)? {
+            let line = Lines::text(input, range.clone());
+            self.blank &= line.bytes().all(|b| b.is_ascii_whitespace());
+            if !without_comment(line).trim().is_empty() {
+                self.last = n;
+                return Ok((n, without_comment(Lines::text(input, range))));
+            }
+        }
+        Err(if self.blank { text::empty_file(path) } else { Error::parse(path, format!("line {}", self.last), what()) })
+    }
+}
+
+/// `line` up to its first `#`.
+fn without_comment(line: Cow<'_, str>) -> Cow<'_, str> {
+    match line.find('#') {
+        Some(hash) => Cow::Owned(line[..hash].to_owned()),
+        None => line,
+    }
 }
 
 /// Whether the keyword announces normals; `[C][N]OFF` and texture `ST` prefixes are accepted.

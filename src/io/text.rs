@@ -22,13 +22,29 @@ pub(crate) fn number<T: FromStr>(token: &str) -> Result<T, String> {
     token.parse().map_err(|_| format!("expected a number, found {}", quoted(token)))
 }
 
-/// `token` in backquotes, shortened if long, for error messages.
+/// `token` in backquotes, shortened if long, for error messages; control characters (NUL,
+/// escape, ...) are escaped, as in `\0` or `\u{1b}`, so a message never carries them.
 pub(crate) fn quoted(token: &str) -> String {
     const MAX: usize = 40;
-    match token.char_indices().nth(MAX) {
-        Some((cut, _)) => format!("`{}...`", &token[..cut]),
-        None => format!("`{token}`"),
+    let (shown, more) = match token.char_indices().nth(MAX) {
+        Some((cut, _)) => (&token[..cut], "..."),
+        None => (token, ""),
+    };
+    let mut text = String::from("`");
+    for c in shown.chars() {
+        if c.is_control() {
+            text.extend(c.escape_debug());
+        } else {
+            text.push(c);
+        }
     }
+    format!("{text}{more}`")
+}
+
+/// Whether `b` is a byte that no text holds: an ASCII control character (NUL, escape,
+/// delete, ...) other than tab, line feed, vertical tab, form feed and carriage return.
+pub(crate) fn is_binary(b: u8) -> bool {
+    b.is_ascii_control() && !matches!(b, b'\t' | b'\n' | 0x0b | 0x0c | b'\r')
 }
 
 /// Vertex `i` of a mesh as `x y z` text: the stored f32 values for a mesh at the origin (the
@@ -52,10 +68,15 @@ impl fmt::Display for Position<'_> {
 /// The error every reader gives for a file with nothing but whitespace in it.
 pub(crate) fn reject_blank(bytes: &[u8], path: &Path) -> Result<(), Error> {
     if bytes.iter().all(u8::is_ascii_whitespace) {
-        Err(Error::parse(path, "line 1", "file is empty"))
+        Err(empty_file(path))
     } else {
         Ok(())
     }
+}
+
+/// The error for a file with nothing but whitespace in it.
+pub(crate) fn empty_file(path: &Path) -> Error {
+    Error::parse(path, "line 1", "file is empty")
 }
 
 #[cfg(test)]
@@ -75,5 +96,6 @@ mod tests {
         assert_eq!(number::<f32>("1.5"), Ok(1.5));
         assert!(number::<f32>("abc").unwrap_err().contains("`abc`"));
         assert!(quoted(&"x".repeat(100)).ends_with("...`"));
+        assert_eq!(quoted("1\u{0}\u{0}\u{1b}[2J\t"), "`1\\0\\0\\u{1b}[2J\\t`");
     }
 }

@@ -1,8 +1,9 @@
 //! XYZ / PWN point clouds: one point per line, `x y z` or `x y z nx ny nz`, the same number of
 //! columns on every line. Blank lines and lines starting with `#` are skipped. Positions and
-//! normals must be finite.
+//! normals must be finite. A NUL byte is refused at its line.
 
 use crate::error::{Error, Result};
+use crate::io::input::{Input, Lines};
 use crate::io::{assemble, text};
 use crate::mesh::Mesh;
 use glam::{DVec3, Vec3};
@@ -11,13 +12,21 @@ use std::path::Path;
 
 /// Parses a whole XYZ/PWN file held in memory. `path` is used only in error messages.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
-    text::reject_blank(bytes, path)?;
+    read(&mut Input::memory(bytes), 0, path)
+}
+
+/// Reads the XYZ/PWN file that starts at byte `start` of `input`, pulling it line by line, so
+/// that reading stops at the first bad line.
+pub(crate) fn read(input: &mut Input, start: usize, path: &Path) -> Result<Mesh> {
     let mut positions = Vec::new();
     let mut normals = Vec::new();
     // Column count and line of the first point, which every other point must match.
     let mut first: Option<(usize, usize)> = None;
     let mut values = Vec::with_capacity(6);
-    for (n, line) in text::lines(bytes) {
+    let mut blank = true;
+    let mut lines = Lines::new(start);
+    while let Some((n, line)) = lines.next(input, path)? {
+        blank &= line.bytes().all(|b| b.is_ascii_whitespace());
         let content = line.trim_start();
         if content.is_empty() || content.starts_with('#') {
             continue;
@@ -42,6 +51,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
             let normal = assemble::finite_normal(DVec3::new(nx, ny, nz).as_vec3());
             normals.push(normal.map_err(|m| at(format!("point {point}: {m}")))?);
         }
+    }
+    if blank {
+        return Err(text::empty_file(path));
     }
     assemble::vertex_count_fits(positions.len()).map_err(|m| Error::TooLarge(format!("{}: {m}", path.display())))?;
     let has_normals = first.is_some_and(|(columns, _)| columns == 6);

@@ -1159,6 +1159,40 @@ static vstree_status three_points(double error, int32_t metric) {
 }
 CALL(simplify_three_points) { return three_points(1e-3, VSTREE_METRIC_L2); }
 CALL(simplify_three_points_density_1) { return three_points(1.0, VSTREE_METRIC_DENSITY); }
+/* A PLY is read up to the end of the elements its header declares: a body of another kind is
+ * refused at its first byte, which the message names (no raw control byte), and a tail after
+ * the elements is ignored. */
+static const char g_ascii_header[] =
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+    "property float z\nend_header\n";
+static char g_nul_body[sizeof g_ascii_header - 1 + 4096];
+static size_t nul_body(void) {
+  memset(g_nul_body, 0, sizeof g_nul_body);
+  memcpy(g_nul_body, g_ascii_header, sizeof g_ascii_header - 1);
+  return sizeof g_nul_body;
+}
+CALL(load_ply_ascii_nul_body) {
+  write_file("nul.ply", g_nul_body, nul_body());
+  return load("nul.ply");
+}
+CALL(memory_ply_ascii_nul_body) { return load_memory(g_nul_body, nul_body(), "ply"); }
+CALL(load_ply_binary_with_tail) {
+  static const char zeros[4096];
+  char path[4096];
+  FILE *f;
+  if (save(g_mesh, "tail.ply", 0) != VSTREE_STATUS_OK) problem("cannot save tail.ply");
+  snprintf(path, sizeof path, "%s/tail.ply", g_dir);
+  f = fopen(path, "ab");
+  if (!f || fwrite(zeros, 1, sizeof zeros, f) != sizeof zeros || fclose(f) != 0) {
+    problem("cannot append to tail.ply");
+  }
+  return load("tail.ply");
+}
+/* Vertex colours are not used: colours on some vertices only are no error. */
+CALL(load_obj_colours_on_some_vertices) {
+  return load_text("colours.obj", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\nv 0 0 1\nf 1 3 2\n"
+                                  "f 1 2 4\nf 1 4 3\nf 2 3 4\n");
+}
 
 #define ROW(call, status, message) {#call, call, VSTREE_STATUS_##status, message}
 
@@ -1786,6 +1820,14 @@ static const bad_case g_cases[] = {
         "the whole model): the model is within this bound of too few planes; use a smaller bound (a "
         "flat model, within any bound of one plane, needs the density metric)"),
     ROW(simplify_three_points_density_1, OK, ""),
+    ROW(load_ply_ascii_nul_body, PARSE,
+        "vstree_mesh_load: {dir}/nul.ply: line 8: vertex 0: byte 0x00: this is binary data, but "
+        "the header says `format ascii`"),
+    ROW(memory_ply_ascii_nul_body, PARSE,
+        "vstree_mesh_load_memory: memory.ply: line 8: vertex 0: byte 0x00: this is binary data, "
+        "but the header says `format ascii`"),
+    ROW(load_ply_binary_with_tail, OK, ""),
+    ROW(load_obj_colours_on_some_vertices, OK, ""),
 };
 
 /* ---- matching and the run ---- */

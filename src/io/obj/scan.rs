@@ -25,6 +25,9 @@ type Counts = [usize; 3];
 pub(super) fn first_malformed(source: &str) -> Option<(usize, String)> {
     let totals = totals(source);
     let mut seen = [0; 3];
+    // The faces of the object being read, each with its line and its largest index of each
+    // kind: tobj checks them against the lines read when the object ends.
+    let mut faces: Vec<(usize, [Option<usize>; 3])> = Vec::new();
     for (n, line) in text::lines(source.as_bytes()) {
         let mut words = line.split_whitespace();
         let keyword = words.next();
@@ -32,18 +35,62 @@ pub(super) fn first_malformed(source: &str) -> Option<(usize, String)> {
             Some("v") => position(words),
             Some("vt") => numbers::<2>(&mut words).map(drop),
             Some("vn") => numbers::<3>(&mut words).map(drop),
-            Some("f" | "l") => corners(words, &seen, &totals).map(drop),
+            Some("f") => corners(words, &seen, &totals).map(|c| faces.extend(largest(&c).map(|l| (n, l)))),
+            Some("l") => corners(words, &seen, &totals).map(drop),
             Some("usemtl") if words.next().is_none() => Err("`usemtl` without a material name".into()),
             _ => Ok(()),
         };
         if let Err(message) = checked {
             return Some((n, message));
         }
+        if matches!(keyword, Some("o" | "g")) {
+            if let Some(found) = ahead_of_object(&faces, &seen, n) {
+                return Some(found);
+            }
+            faces.clear();
+        }
         if let Some(k) = KEYWORDS.iter().position(|k| Some(*k) == keyword) {
             seen[k] += 1;
         }
     }
     None
+}
+
+/// The largest index of each kind among `corners`; `None` for a face without corners.
+fn largest(corners: &[[Option<usize>; 3]]) -> Option<[Option<usize>; 3]> {
+    let first = *corners.first()?;
+    Some(corners.iter().fold(first, |most, corner| std::array::from_fn(|k| most[k].max(corner[k]))))
+}
+
+/// The first of `faces` (of an object that ends at line `end`, after `seen` lines of each
+/// kind) that uses a line after the object's end: tobj refuses it, although the file has it.
+fn ahead_of_object(faces: &[(usize, [Option<usize>; 3])], seen: &Counts, end: usize) -> Option<(usize, String)> {
+    faces.iter().find_map(|(line, most)| {
+        (0..3).find_map(|k| {
+            let index = most[k].filter(|&i| i >= seen[k])? + 1;
+            let (name, keyword, before) = (NAMES[k], KEYWORDS[k], seen[k]);
+            Some((
+                *line,
+                format!(
+                    "{name} index {index} is out of range: its object ends at line {end} after {before} `{keyword}` \
+                     lines, and a face may only use those"
+                ),
+            ))
+        })
+    })
+}
+
+/// `source` with the colours of its `v x y z r g b` lines dropped, every line where it was.
+pub(super) fn without_colours(source: &str) -> String {
+    let mut kept = String::with_capacity(source.len());
+    for line in source.split_inclusive('\n') {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words[..] {
+            ["v", x, y, z, _, _, _] => kept.push_str(&format!("v {x} {y} {z}\n")),
+            _ => kept.push_str(line),
+        }
+    }
+    kept
 }
 
 /// The first `f` line with fewer than three corners, as `(line, what is wrong)`: tobj drops

@@ -4,20 +4,30 @@
 //! Each item must be exactly one line: too few or too many values are reported at that line,
 //! with the count expected. Blank (whitespace-only) lines between items are skipped, since an
 //! item always holds at least one value and so a blank line cannot be one; trailing
-//! whitespace and `\r\n` line ends are accepted.
+//! whitespace and `\r\n` line ends are accepted. A byte that no text holds (NUL, another
+//! control character) is refused where it is met, so a binary body behind an `ascii` header
+//! is not read on.
 
 use super::header::Header;
 use super::items::{self, Cursor, Fail, Parts};
 use super::plan::Plan;
 use super::scalar::Scalar;
 use crate::error::Result;
+use crate::io::input::Input;
 use crate::io::text;
 use crate::mesh::Mesh;
 use std::path::Path;
 
-/// Reads the body `bytes`, which starts on line `first_line`.
-pub(crate) fn read(bytes: &[u8], first_line: usize, header: &Header, plan: &Plan, path: &Path) -> Result<Mesh> {
-    let mut tokens = Tokens { bytes, pos: 0, line: first_line, item_line: first_line, found: 0 };
+/// Reads the body that starts at byte `start` of `input`, on line `first_line`.
+pub(crate) fn read(
+    input: &mut Input,
+    start: usize,
+    first_line: usize,
+    header: &Header,
+    plan: &Plan,
+    path: &Path,
+) -> Result<Mesh> {
+    let mut tokens = Tokens { input, pos: start, line: first_line, item_line: first_line, found: 0 };
     let mut parts = Parts::new(plan.vertex_count, plan.has_normals);
     for (element, job) in header.elements.iter().zip(&plan.jobs) {
         items::read_element(&mut tokens, element, job, &mut parts, path)?;
@@ -26,8 +36,8 @@ pub(crate) fn read(bytes: &[u8], first_line: usize, header: &Header, plan: &Plan
 }
 
 /// Whitespace-separated tokens, read one line (item) at a time.
-struct Tokens<'a> {
-    bytes: &'a [u8],
+struct Tokens<'i, 'a> {
+    input: &'i mut Input<'a>,
     pos: usize,
     /// Line at `pos`.
     line: usize,
@@ -37,34 +47,55 @@ struct Tokens<'a> {
     found: usize,
 }
 
-impl<'a> Tokens<'a> {
-    /// Skips whitespace up to, not over, the end of the line (`\r` is whitespace).
-    fn skip_spaces(&mut self) {
-        while self.bytes.get(self.pos).is_some_and(|&b| b != b'\n' && b.is_ascii_whitespace()) {
-            self.pos += 1;
+impl Tokens<'_, '_> {
+    /// Moves over the bytes for which `keep` holds; returns the byte it stops at, if any.
+    #[inline]
+    fn advance(&mut self, keep: impl Fn(u8) -> bool) -> Option<u8> {
+        loop {
+            let bytes = self.input.available(self.pos);
+            if bytes.is_empty() {
+                return None;
+            }
+            match bytes.iter().position(|&b| !keep(b)) {
+                Some(at) => {
+                    let stop = bytes[at];
+                    self.pos += at;
+                    return Some(stop);
+                }
+                None => self.pos += bytes.len(),
+            }
         }
     }
 
-    /// The next token on the current line, or `None` at the line's end.
-    fn next_token(&mut self) -> Option<&'a [u8]> {
+    /// Skips whitespace up to, not over, the end of the line (`\r` is whitespace).
+    fn skip_spaces(&mut self) {
+        self.advance(|b| b != b'\n' && b.is_ascii_whitespace());
+    }
+
+    /// The next token on the current line, or `None` at the line's end; an error at a byte
+    /// that no text holds.
+    fn next_token(&mut self) -> Result<Option<&[u8]>, Fail> {
         self.skip_spaces();
         let start = self.pos;
-        while self.bytes.get(self.pos).is_some_and(|b| !b.is_ascii_whitespace()) {
-            self.pos += 1;
+        match self.advance(|b| !b.is_ascii_whitespace() && !text::is_binary(b)) {
+            Some(b) if text::is_binary(b) => {
+                Err(Fail::Bad(format!("byte {b:#04x}: this is binary data, but the header says `format ascii`")))
+            }
+            _ => Ok(Some(self.input.get(start, self.pos - start)).filter(|t| !t.is_empty())),
         }
-        self.bytes.get(start..self.pos).filter(|t| !t.is_empty())
     }
 
     fn parse<T: std::str::FromStr>(&mut self) -> Result<T, Fail> {
-        let token = self.next_token().ok_or(Fail::Count { found: self.found })?;
-        self.found += 1;
+        let found = self.found;
+        let token = self.next_token()?.ok_or(Fail::Count { found })?;
         // Borrows unless the token is invalid UTF-8, which is not a number anyway.
-        let token = String::from_utf8_lossy(token);
-        text::number(&token).map_err(Fail::Bad)
+        let parsed = text::number(&String::from_utf8_lossy(token)).map_err(Fail::Bad);
+        self.found += 1;
+        parsed
     }
 }
 
-impl Cursor for Tokens<'_> {
+impl Cursor for Tokens<'_, '_> {
     fn number(&mut self, _: Scalar) -> Result<f64, Fail> {
         self.parse()
     }
@@ -72,7 +103,7 @@ impl Cursor for Tokens<'_> {
     fn start_item(&mut self) -> Result<(), Fail> {
         loop {
             self.skip_spaces();
-            match self.bytes.get(self.pos) {
+            match self.input.byte(self.pos) {
                 None => return Err(Fail::End),
                 Some(b'\n') => {
                     self.pos += 1;
@@ -88,14 +119,14 @@ impl Cursor for Tokens<'_> {
 
     fn finish_item(&mut self) -> Result<(), Fail> {
         let mut extra = 0;
-        while self.next_token().is_some() {
+        while self.next_token()?.is_some() {
             extra += 1;
         }
         if extra > 0 {
             return Err(Fail::Count { found: self.found + extra });
         }
         // Now at the line break, or at the end of a file whose last line has none.
-        if self.bytes.get(self.pos) == Some(&b'\n') {
+        if self.input.byte(self.pos) == Some(b'\n') {
             self.pos += 1;
             self.line += 1;
         }
@@ -103,7 +134,7 @@ impl Cursor for Tokens<'_> {
     }
 
     fn remaining(&self) -> usize {
-        self.bytes.len().saturating_sub(self.pos)
+        self.input.remaining(self.pos)
     }
 
     fn line(&self) -> Option<usize> {

@@ -7,12 +7,20 @@ use super::items::{self, Cursor, Fail, Parts};
 use super::plan::{Job, Plan, Role, Target};
 use super::scalar::Scalar;
 use crate::error::Result;
+use crate::io::input::Input;
 use crate::mesh::Mesh;
 use std::path::Path;
 
-/// Reads the body `bytes` in the given byte order.
-pub(crate) fn read(bytes: &[u8], big_endian: bool, header: &Header, plan: &Plan, path: &Path) -> Result<Mesh> {
-    let mut cursor = Bytes { data: bytes, pos: 0, big_endian };
+/// Reads the body that starts at byte `start` of `input`, in the given byte order.
+pub(crate) fn read(
+    input: &mut Input,
+    start: usize,
+    big_endian: bool,
+    header: &Header,
+    plan: &Plan,
+    path: &Path,
+) -> Result<Mesh> {
+    let mut cursor = Bytes { input, pos: start, big_endian };
     let mut parts = Parts::new(plan.vertex_count, plan.has_normals);
     for (element, job) in header.elements.iter().zip(&plan.jobs) {
         match fixed_layout(element, job) {
@@ -52,10 +60,11 @@ fn read_fixed(cursor: &mut Bytes, element: &Element, layout: &Layout, parts: &mu
     if layout.stride == 0 {
         return Ok(());
     }
-    let available = cursor.remaining();
+    let big_endian = cursor.big_endian;
+    let start = cursor.pos;
     let block = element.count.checked_mul(layout.stride).and_then(|size| cursor.take(size));
     let Some(block) = block else {
-        let item = available / layout.stride;
+        let item = cursor.input.pulled().len().saturating_sub(start) / layout.stride;
         return Err(items::error(path, None, element, item, Fail::End));
     };
     if !layout.vertices {
@@ -66,7 +75,7 @@ fn read_fixed(cursor: &mut Bytes, element: &Element, layout: &Layout, parts: &mu
     for (item, bytes) in block.chunks_exact(layout.stride).enumerate() {
         let mut decoded = Ok(());
         for &(offset, ty, slot) in &layout.fields {
-            match bytes.get(offset..).and_then(|b| ty.decode(b, cursor.big_endian)) {
+            match bytes.get(offset..).and_then(|b| ty.decode(b, big_endian)) {
                 Some(value) => coords[slot] = value,
                 None => decoded = Err(Fail::End),
             }
@@ -79,27 +88,31 @@ fn read_fixed(cursor: &mut Bytes, element: &Element, layout: &Layout, parts: &mu
 }
 
 /// A position in a binary body.
-struct Bytes<'a> {
-    data: &'a [u8],
+struct Bytes<'i, 'a> {
+    input: &'i mut Input<'a>,
     pos: usize,
     big_endian: bool,
 }
 
-impl<'a> Bytes<'a> {
+impl Bytes<'_, '_> {
     /// The next `n` bytes, or `None` (without moving) if fewer are left.
-    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
-        let end = self.pos.checked_add(n)?;
-        let bytes = self.data.get(self.pos..end)?;
+    fn take(&mut self, n: usize) -> Option<&[u8]> {
+        let start = self.pos;
+        let end = start.checked_add(n)?;
+        if self.input.get(start, n).len() < n {
+            return None;
+        }
         self.pos = end;
-        Some(bytes)
+        Some(self.input.get(start, n))
     }
 }
 
-impl Cursor for Bytes<'_> {
+impl Cursor for Bytes<'_, '_> {
     #[inline]
     fn number(&mut self, ty: Scalar) -> Result<f64, Fail> {
+        let big_endian = self.big_endian;
         let bytes = self.take(ty.size()).ok_or(Fail::End)?;
-        ty.decode(bytes, self.big_endian).ok_or(Fail::End)
+        ty.decode(bytes, big_endian).ok_or(Fail::End)
     }
 
     fn skip(&mut self, ty: Scalar, n: usize) -> Result<(), Fail> {
@@ -108,7 +121,7 @@ impl Cursor for Bytes<'_> {
     }
 
     fn remaining(&self) -> usize {
-        self.data.len().saturating_sub(self.pos)
+        self.input.remaining(self.pos)
     }
 
     fn line(&self) -> Option<usize> {

@@ -51,8 +51,10 @@ pub(crate) struct Header {
 /// The location of the error for a header without `end_header`.
 pub(crate) const UNFINISHED: &str = "header";
 
-/// Parses the header at the start of `bytes`.
-pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Header> {
+/// Parses the header at the start of `bytes`. With `more`, the input goes on after `bytes`:
+/// their last line may be cut, so it is only checked for binary bytes, and a header that
+/// `bytes` do not finish is the [`UNFINISHED`] error.
+pub(crate) fn parse(bytes: &[u8], more: bool, path: &Path) -> Result<Header> {
     const BAD_MAGIC: &str = "not a PLY file: it must start with a `ply` line";
     if bytes.is_empty() {
         return Err(Error::parse(path, "line 1", "file is empty"));
@@ -64,8 +66,15 @@ pub(crate) fn parse(bytes: &[u8], path: &Path) -> Result<Header> {
     let mut elements: Vec<Element> = Vec::new();
     let mut offset = 0;
     for (number, line) in text::lines(bytes) {
+        let start = offset;
         offset += line_length(bytes.get(offset..).unwrap_or_default());
         let fail = |message: String| Error::parse(path, format!("line {number}"), message);
+        if let Some(&b) = bytes[start..offset].iter().find(|&&b| text::is_binary(b)) {
+            return Err(fail(format!("byte {b:#04x}: this is binary data, but a PLY header is text")));
+        }
+        if more && !bytes[..offset].ends_with(b"\n") {
+            break;
+        }
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
             ["ply"] if number == 1 => {}
@@ -124,7 +133,7 @@ mod tests {
     use super::*;
 
     fn parse_str(s: &str) -> Result<Header> {
-        parse(s.as_bytes(), Path::new("t.ply"))
+        parse(s.as_bytes(), false, Path::new("t.ply"))
     }
 
     #[test]

@@ -17,28 +17,41 @@ mod write;
 
 pub(crate) use write::write;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::io::input::{Input, PREFIX_BYTES};
 use crate::mesh::Mesh;
-use header::Encoding;
+use header::{Encoding, Header};
 use plan::Plan;
 use std::path::Path;
 
-/// The location of the error for a header that `end_header` does not finish.
-pub(crate) const UNFINISHED_HEADER: &str = header::UNFINISHED;
-
-/// Checks the header at the start of `bytes` without reading the body.
-pub(crate) fn check_header(bytes: &[u8], path: &Path) -> Result<()> {
-    header::parse(bytes, path).map(drop)
+/// Parses a whole PLY file held in memory. `path` is used only in error messages. Bytes after
+/// the elements the header declares are ignored.
+pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
+    read(&mut Input::memory(bytes), 0, path)
 }
 
-/// Parses a whole PLY file held in memory. `path` is used only in error messages.
-pub fn parse(bytes: &[u8], path: &Path) -> Result<Mesh> {
-    let header = header::parse(bytes, path)?;
+/// Reads the PLY file that starts at byte `start` of `input`, pulling its header and then
+/// the elements the header declares, and nothing after them.
+pub(crate) fn read(input: &mut Input, start: usize, path: &Path) -> Result<Mesh> {
+    let header = read_header(input, start, path)?;
     let plan = Plan::new(&header, path)?;
-    let body = bytes.get(header.body_start..).unwrap_or_default();
+    let body = start + header.body_start;
     match header.encoding {
-        Encoding::Ascii => ascii::read(body, header.lines + 1, &header, &plan, path),
-        Encoding::BinaryLittleEndian => binary::read(body, false, &header, &plan, path),
-        Encoding::BinaryBigEndian => binary::read(body, true, &header, &plan, path),
+        Encoding::Ascii => ascii::read(input, body, header.lines + 1, &header, &plan, path),
+        Encoding::BinaryLittleEndian => binary::read(input, body, false, &header, &plan, path),
+        Encoding::BinaryBigEndian => binary::read(input, body, true, &header, &plan, path),
+    }
+}
+
+/// The header at byte `start` of `input`, pulling twice as much each time it is unfinished.
+fn read_header(input: &mut Input, start: usize, path: &Path) -> Result<Header> {
+    let mut want = PREFIX_BYTES;
+    loop {
+        let bytes = input.get(start, want);
+        let more = bytes.len() == want;
+        match header::parse(bytes, more, path) {
+            Err(Error::Parse { location, .. }) if more && location == header::UNFINISHED => want *= 2,
+            result => return result,
+        }
     }
 }
