@@ -34,6 +34,8 @@ def sphere_points(count=200):
 
 
 P, T, N = grid_torus()
+THREE = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
+UP = np.array([[0, 0, 1]] * 3, np.float32)
 CLOUD = sphere_points()
 
 
@@ -246,6 +248,11 @@ PARAMETER_CASES = [
          "vstree_simplify: parameter `error`: NaN: must be a finite number > 0"),
     case("simplify-error-inf", simplify_with(error=INF), vstree.VstreeError, BAD,
          "vstree_simplify: parameter `error`: inf: must be a finite number > 0"),
+    # A cloud that keeps nothing of its shape is an error, not one point (issue 26, item 14).
+    case("simplify-three-points", lambda c: vstree.simplify(vstree.Mesh(THREE, None, UP)), vstree.VstreeError, BAD,
+         "vstree_simplify: parameter `error`: 0.001: all 3 points collapsed into one (1 cluster for the whole "
+         "model): the model is within this bound of too few planes; use a smaller bound (a flat model, within "
+         "any bound of one plane, needs the density metric)"),
     case("simplify-d_a-too-big", simplify_with(d_a=2.0), vstree.VstreeError, BAD,
          "vstree_simplify: parameter `d_a`: 2: must be in [0, 1]"),
     case("simplify-d_a-nan", simplify_with(d_a=NAN), vstree.VstreeError, BAD,

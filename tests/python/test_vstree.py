@@ -80,6 +80,18 @@ def test_simplify_gives_a_smaller_mesh_and_statistics(shape):
     assert octree["t_nodes"] == 0
 
 
+def test_every_metric_has_a_valid_default_and_a_size_ignores_the_bound(shape):
+    # The density metric counts samples per cell: the struct's default 1e-3 is read as its own
+    # default (16), and with a size the bound is neither used nor checked (issue 26, item 9).
+    p, t, _ = shape
+    mesh = vstree.Mesh(p, t)
+    for metric in ("l2", "l21", "density"):
+        out, s = vstree.simplify(mesh, metric=metric, keep_topology="off")
+        assert 0 < out.triangle_count < len(t), metric
+        out, s = vstree.simplify(mesh, metric=metric, error=float("nan"), target_faces=300)
+        assert abs(out.triangle_count - 300) <= 3, (metric, out.triangle_count)
+
+
 def test_simplify_to_a_size_keeps_a_closed_torus_closed(shape):
     p, t, _ = shape
     mesh = vstree.Mesh(p, t)

@@ -569,7 +569,8 @@ SimplifyResult.__doc__ = "The simplified :class:`Mesh` and a dict of statistics.
 def simplify(mesh, progress=None, ratio=None, **params):
     """Simplifies ``mesh`` (a :class:`Mesh`, or a point cloud with normals) by clustering in a
     VS-Tree. Parameters are the C struct's fields: ``error`` (L2: relative to the squared
-    bounding-box diagonal; default 1e-3), ``tree_kind`` ("vstree" | "octree"), ``metric``
+    bounding-box diagonal; default 1e-3; with ``metric="density"`` samples per cell, default
+    16; not used with a size), ``tree_kind`` ("vstree" | "octree"), ``metric``
     ("l2" | "l21" | "density"), ``sampling`` ("vertices" | "faces"), ``d_a``, ``d_d``,
     ``max_depth``, ``threads`` (0 = all cores), ``min_cell_size``, ``keep_topology``
     ("auto": kept for closed 2-manifolds, the default; "on" or True; "off" or False: plain
