@@ -1045,7 +1045,8 @@ typedef struct vstree_reconstruct_stats {
    */
   uint64_t input_points;
   /**
-   * Samples the tree was built from.
+   * Samples the tree was built from: `input_points` less the isolated points left out
+   * (stray points far from the rest for their neighbours' spacing).
    */
   uint64_t samples;
   /**

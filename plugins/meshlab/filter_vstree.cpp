@@ -460,6 +460,9 @@ std::map<std::string, QVariant> FilterVstreePlugin::apply(
 			vstree_refinement_stopped_str(s->stopped),
 			s->stopped == VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET ? "; raise the error bound" : "",
 			s->final_error, (unsigned long long)s->normals_estimated, s->seconds_total);
+		if (s->input_points > s->samples)
+			logf("%llu isolated points left out (far from the rest for their neighbours' spacing)",
+				(unsigned long long)(s->input_points - s->samples));
 		out["output_vertices"] = QVariant(int(s->output_vertices));
 		out["output_triangles"] = QVariant(int(s->output_triangles));
 		out["levels"] = QVariant(int(s->levels));

@@ -233,7 +233,8 @@ pub struct vstree_reconstruct_stats {
     pub normals_flipped: u64,
     /// Points of the input cloud.
     pub input_points: u64,
-    /// Samples the tree was built from.
+    /// Samples the tree was built from: `input_points` less the isolated points left out
+    /// (stray points far from the rest for their neighbours' spacing).
     pub samples: u64,
     /// Nodes of the tree, of every kind.
     pub nodes: u64,

@@ -353,6 +353,15 @@ def test_reconstruct_a_sphere_from_numpy_points():
     assert np.mean(np.einsum("ij,ij->i", mesh.normals, mesh.positions) > 0) > 0.99
 
 
+def test_reconstruct_leaves_out_a_stray_point_and_counts_it():
+    # One point 1000 diameters away made the base mesh empty (issue 26, item 8).
+    points = np.vstack([fibonacci_sphere(), [[2000.0, 0.0, 0.0]]]).astype(np.float32)
+    mesh, s = vstree.reconstruct(points, max_levels=1)
+    assert s["input_points"] - s["samples"] == 1
+    assert euler_genus(mesh) == (0, True)
+    assert np.abs(np.linalg.norm(mesh.positions, axis=1) - 1).max() < 0.02
+
+
 def test_reconstruct_a_torus_with_and_without_normals():
     p, n = torus_cloud()
     with_normals = vstree.reconstruct(p, n, max_levels=2, max_grid_depth=7)

@@ -339,9 +339,15 @@ class VSTREE_OT_reconstruct(_Worker, bpy.types.Operator):
             o.select_set(False)
         target.select_set(True)
         context.view_layer.objects.active = target
+        isolated = stats["input_points"] - stats["samples"]
         self.report(
             {'INFO'},
-            "VS-Tree: surface with %d vertices, %d triangles" % (len(target.data.vertices), len(target.data.polygons)),
+            "VS-Tree: surface with %d vertices, %d triangles%s"
+            % (
+                len(target.data.vertices),
+                len(target.data.polygons),
+                "; %d isolated points left out" % isolated if isolated > 0 else "",
+            ),
         )
         return {'FINISHED'}
 
