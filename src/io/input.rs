@@ -116,8 +116,9 @@ impl<'a> Input<'a> {
         let want = (end - have).max(CHUNK);
         let bytes = self.data.to_mut();
         // Room grows geometrically (pulls are small), but never past the size of the input.
-        let room = want.max(have).min(self.size.saturating_sub(have) + 1);
-        bytes.reserve_exact(room);
+        if bytes.capacity() - have < want {
+            bytes.reserve_exact(want.max(have).min(self.size.saturating_sub(have) + 1));
+        }
         match source.take(want as u64).read_to_end(bytes) {
             Ok(got) if got == want => {}
             Ok(_) => self.source = None,
