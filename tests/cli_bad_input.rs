@@ -538,6 +538,19 @@ fn cases() -> Vec<Case> {
             exact(""),
         )
     });
+    // A line no real file holds (digits without end) is refused once it passes its bound.
+    cases.push(fail(
+        "XYZ line of 17 MiB of digits",
+        vec![file("d.xyz", Entry::Bytes([b"0 0 0\n".to_vec(), vec![b'7'; 17 << 20]].concat()))],
+        &["stats", "d.xyz"],
+        error("d.xyz: line 2: the line goes on past 16 MiB without a line break: no mesh file has such a line"),
+    ));
+    cases.push(fail(
+        "PLY header line of 2 MiB",
+        vec![file("h.ply", Entry::Bytes([b"ply\ncomment ".to_vec(), vec![b'x'; 2 << 20]].concat()))],
+        &["stats", "h.ply"],
+        error("h.ply: line 2: the header goes on past 1 MiB without `end_header`: no PLY header is that long"),
+    ));
     cases
 }
 

@@ -20,6 +20,11 @@ pub(crate) const PREFIX_BYTES: usize = 64 * 1024;
 /// last byte a reader asked for.
 const CHUNK: usize = 64 * 1024;
 
+/// The most bytes a line of an OFF, XYZ or ASCII PLY file may hold (16 MiB): its longest real
+/// line is a face, and a face of a million corners with 10-digit indices takes 11 MB, so a
+/// longer line is not one of these formats and reading stops there instead of holding it.
+pub(crate) const MAX_LINE: usize = 16 << 20;
+
 /// Runs `read` on the bytes of the regular file at `path`, pulled from the file as `read` asks
 /// for them; an error reading the file, or a file that grows meanwhile, is reported instead of
 /// what `read` returns.
@@ -111,8 +116,9 @@ impl<'a> Input<'a> {
         let want = (end - have).max(CHUNK);
         let bytes = self.data.to_mut();
         // Room grows geometrically (pulls are small), but never past the size of the input.
-        let room = want.max(have).min(self.size.saturating_sub(have) + 1);
-        bytes.reserve_exact(room);
+        if bytes.capacity() - have < want {
+            bytes.reserve_exact(want.max(have).min(self.size.saturating_sub(have) + 1));
+        }
         match source.take(want as u64).read_to_end(bytes) {
             Ok(got) if got == want => {}
             Ok(_) => self.source = None,
@@ -143,7 +149,8 @@ impl<'a> Input<'a> {
 
 /// The lines of a text input, pulled one at a time, as [`crate::io::text::lines`] splits
 /// bytes in memory: numbered from 1, without their `\n` or `\r\n`, invalid UTF-8 replaced. A
-/// NUL byte, which no text file holds, is refused at its line, before the rest is pulled.
+/// NUL byte, which no text file holds, is refused at its line, before the rest is pulled, and
+/// so is a line longer than [`MAX_LINE`].
 pub(crate) struct Lines {
     pos: usize,
     number: usize,
@@ -186,6 +193,9 @@ impl Lines {
                 None if bytes.len() == scanned => {
                     self.ended = true;
                     break scanned;
+                }
+                None if bytes.len() > MAX_LINE => {
+                    return Err(Error::parse(path, format!("line {}", self.number + 1), line_too_long()));
                 }
                 None => scanned = bytes.len(),
             }
@@ -275,6 +285,11 @@ fn nul_error(before: &[u8], path: &Path) -> Error {
     Error::parse(path, format!("line {line}"), NUL_BYTE)
 }
 
+/// The message for a line longer than [`MAX_LINE`].
+pub(crate) fn line_too_long() -> String {
+    format!("the line goes on past {} MiB without a line break: no mesh file has such a line", MAX_LINE >> 20)
+}
+
 const NUL_BYTE: &str = "a NUL byte: this is binary data, not a text file";
 
 #[cfg(test)]
@@ -353,6 +368,31 @@ mod tests {
         let message = read.unwrap_err().to_string();
         assert_eq!(message, "t: line 3: byte 0x00: this is binary data, but a PLY header is text");
         assert_eq!(pulled, PREFIX_BYTES);
+    }
+
+    #[test]
+    fn an_endless_line_is_refused_after_a_bounded_pull() {
+        // Each file then 2 GiB of digits: one endless token, on a line that never ends.
+        let header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                      property float z\nend_header\n";
+        let long = "the line goes on past 16 MiB without a line break: no mesh file has such a line";
+        let cases = [
+            (Format::Ply, format!("{header}0 0 0\n1 "), format!("line 9: vertex 1: {long}")),
+            (Format::Off, "OFF\n3 1 0\n0 0 0\n".into(), format!("line 4: {long}")),
+            (Format::Xyz, "0 0 0\n".into(), format!("line 2: {long}")),
+            (
+                Format::Ply,
+                "ply\nformat ascii 1.0\ncomment ".into(),
+                "line 3: the header goes on past 1 MiB \
+              without `end_header`: no PLY header is that long"
+                    .into(),
+            ),
+        ];
+        for (format, file, expected) in cases {
+            let (read, pulled) = read_with_tail(format, file.as_bytes(), b'7');
+            assert_eq!(read.unwrap_err().to_string(), format!("t: {expected}"), "{format:?}");
+            assert!(pulled <= MAX_LINE + 2 * CHUNK, "{format:?}: {pulled} bytes pulled");
+        }
     }
 
     #[test]

@@ -43,7 +43,7 @@ pub(crate) fn quoted(token: &str) -> String {
 
 /// Whether `b` is a byte that no text holds: an ASCII control character (NUL, escape,
 /// delete, ...) other than tab, line feed, vertical tab, form feed and carriage return.
-pub(crate) fn is_binary(b: u8) -> bool {
+pub(crate) const fn is_binary(b: u8) -> bool {
     b.is_ascii_control() && !matches!(b, b'\t' | b'\n' | 0x0b | 0x0c | b'\r')
 }
 

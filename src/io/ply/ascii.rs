@@ -6,14 +6,14 @@
 //! item always holds at least one value and so a blank line cannot be one; trailing
 //! whitespace and `\r\n` line ends are accepted. A byte that no text holds (NUL, another
 //! control character) is refused where it is met, so a binary body behind an `ascii` header
-//! is not read on.
+//! is not read on, and so is a line longer than [`MAX_LINE`], which no real file holds.
 
 use super::header::Header;
 use super::items::{self, Cursor, Fail, Parts};
 use super::plan::Plan;
 use super::scalar::Scalar;
 use crate::error::Result;
-use crate::io::input::Input;
+use crate::io::input::{self, Input, MAX_LINE};
 use crate::io::text;
 use crate::mesh::Mesh;
 use std::path::Path;
@@ -27,7 +27,7 @@ pub(crate) fn read(
     plan: &Plan,
     path: &Path,
 ) -> Result<Mesh> {
-    let mut tokens = Tokens { input, pos: start, line: first_line, item_line: first_line, found: 0 };
+    let mut tokens = Tokens { input, pos: start, line: first_line, line_start: start, item_line: first_line, found: 0 };
     let mut parts = Parts::new(plan.vertex_count, plan.has_normals);
     for (element, job) in header.elements.iter().zip(&plan.jobs) {
         items::read_element(&mut tokens, element, job, &mut parts, path)?;
@@ -35,12 +35,26 @@ pub(crate) fn read(
     Ok(parts.into_mesh())
 }
 
+/// Whether a byte may be in a token: it is neither whitespace nor a byte that no text holds.
+/// A table, since every byte of the body is looked up in it.
+static IN_TOKEN: [bool; 256] = {
+    let mut table = [false; 256];
+    let mut b = 0;
+    while b < 256 {
+        table[b] = !(b as u8).is_ascii_whitespace() && !text::is_binary(b as u8);
+        b += 1;
+    }
+    table
+};
+
 /// Whitespace-separated tokens, read one line (item) at a time.
 struct Tokens<'i, 'a> {
     input: &'i mut Input<'a>,
     pos: usize,
     /// Line at `pos`.
     line: usize,
+    /// Where that line starts, which bounds how far it may go on.
+    line_start: usize,
     /// Line of the current item.
     item_line: usize,
     /// Values read so far from the current item's line.
@@ -48,40 +62,54 @@ struct Tokens<'i, 'a> {
 }
 
 impl Tokens<'_, '_> {
-    /// Moves over the bytes for which `keep` holds; returns the byte it stops at, if any.
+    /// Moves over the bytes for which `keep` holds; returns the byte it stops at, if any. The
+    /// line may not go on past [`MAX_LINE`]: this is checked each time the bytes pulled so far
+    /// are used up, so no more than that (and one pull) is pulled.
     #[inline]
-    fn advance(&mut self, keep: impl Fn(u8) -> bool) -> Option<u8> {
+    fn advance(&mut self, keep: impl Fn(u8) -> bool) -> Result<Option<u8>, Fail> {
         loop {
             let bytes = self.input.available(self.pos);
             if bytes.is_empty() {
-                return None;
+                return Ok(None);
             }
             match bytes.iter().position(|&b| !keep(b)) {
                 Some(at) => {
                     let stop = bytes[at];
                     self.pos += at;
-                    return Some(stop);
+                    return Ok(Some(stop));
                 }
                 None => self.pos += bytes.len(),
+            }
+            if self.pos - self.line_start > MAX_LINE {
+                return Err(Fail::Bad(input::line_too_long()));
             }
         }
     }
 
     /// Skips whitespace up to, not over, the end of the line (`\r` is whitespace).
-    fn skip_spaces(&mut self) {
-        self.advance(|b| b != b'\n' && b.is_ascii_whitespace());
+    fn skip_spaces(&mut self) -> Result<(), Fail> {
+        self.advance(|b| b != b'\n' && b.is_ascii_whitespace()).map(drop)
+    }
+
+    /// Moves over the line break at `pos`.
+    fn next_line(&mut self) {
+        self.pos += 1;
+        self.line += 1;
+        self.line_start = self.pos;
     }
 
     /// The next token on the current line, or `None` at the line's end; an error at a byte
-    /// that no text holds.
+    /// that no text holds. Inlined into its callers: it runs once per value of the body.
+    #[inline(always)]
     fn next_token(&mut self) -> Result<Option<&[u8]>, Fail> {
-        self.skip_spaces();
+        self.skip_spaces()?;
         let start = self.pos;
-        match self.advance(|b| !b.is_ascii_whitespace() && !text::is_binary(b)) {
+        match self.advance(|b| IN_TOKEN[b as usize])? {
             Some(b) if text::is_binary(b) => {
                 Err(Fail::Bad(format!("byte {b:#04x}: this is binary data, but the header says `format ascii`")))
             }
-            _ => Ok(Some(self.input.get(start, self.pos - start)).filter(|t| !t.is_empty())),
+            // The token's bytes are pulled: `advance` went over them.
+            _ => Ok(Some(&self.input.pulled()[start..self.pos]).filter(|t| !t.is_empty())),
         }
     }
 
@@ -102,13 +130,10 @@ impl Cursor for Tokens<'_, '_> {
 
     fn start_item(&mut self) -> Result<(), Fail> {
         loop {
-            self.skip_spaces();
+            self.skip_spaces()?;
             match self.input.byte(self.pos) {
                 None => return Err(Fail::End),
-                Some(b'\n') => {
-                    self.pos += 1;
-                    self.line += 1;
-                }
+                Some(b'\n') => self.next_line(),
                 Some(_) => break,
             }
         }
@@ -127,8 +152,7 @@ impl Cursor for Tokens<'_, '_> {
         }
         // Now at the line break, or at the end of a file whose last line has none.
         if self.input.byte(self.pos) == Some(b'\n') {
-            self.pos += 1;
-            self.line += 1;
+            self.next_line();
         }
         Ok(())
     }

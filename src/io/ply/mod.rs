@@ -43,14 +43,30 @@ pub(crate) fn read(input: &mut Input, start: usize, path: &Path) -> Result<Mesh>
     }
 }
 
-/// The header at byte `start` of `input`, pulling twice as much each time it is unfinished.
+/// The most bytes a PLY header may hold (1 MiB): a header declares its elements and
+/// properties in a few hundred bytes, so even thousands of comment lines stay far below, and
+/// a longer one is not a header: reading stops there instead of holding it.
+const MAX_HEADER: usize = 1 << 20;
+
+/// The header at byte `start` of `input`, pulling twice as much each time it is unfinished,
+/// up to [`MAX_HEADER`].
 fn read_header(input: &mut Input, start: usize, path: &Path) -> Result<Header> {
     let mut want = PREFIX_BYTES;
     loop {
         let bytes = input.get(start, want);
         let more = bytes.len() == want;
         match header::parse(bytes, more, path) {
-            Err(Error::Parse { location, .. }) if more && location == header::UNFINISHED => want *= 2,
+            Err(Error::Parse { location, .. }) if more && location == header::UNFINISHED => {
+                if want >= MAX_HEADER {
+                    let line = 1 + bytes.iter().filter(|&&b| b == b'\n').count();
+                    let message = format!(
+                        "the header goes on past {} MiB without `end_header`: no PLY header is that long",
+                        MAX_HEADER >> 20
+                    );
+                    return Err(Error::parse(path, format!("line {line}"), message));
+                }
+                want *= 2;
+            }
             result => return result,
         }
     }
