@@ -55,8 +55,10 @@ const NOISE_SEED: u64 = 7;
 const TRUTH_SEED: u64 = 77;
 /// Points sampled on the ground truth for its side of the two-sided distances.
 pub const TRUTH_SAMPLES: usize = 200_000;
-/// Per-axis standard deviation of the position noise, over the bounding-box diagonal.
+/// Per-axis standard deviation of the position noise, over the bounding-box diagonal: what a
+/// good scanner leaves ([`Variant::Noisy`]), and twice that, a poor one ([`Variant::VeryNoisy`]).
 pub const NOISE: f32 = 0.0025;
+pub const HIGH_NOISE: f32 = 0.005;
 /// Direction of the single-view scans (towards the viewer) and the z-buffer's resolution.
 pub const VIEW: Vec3 = Vec3::new(1.0, 2.0, 3.0);
 pub const ZBUFFER: usize = 1024;
@@ -94,6 +96,8 @@ pub enum Variant {
     NoNormals,
     /// Gaussian noise of [`NOISE`] of the diagonal on the positions, exact normals kept.
     Noisy,
+    /// The same with [`HIGH_NOISE`].
+    VeryNoisy,
     /// Exact normals, open (hemisphere) or seen from one side (single view).
     Open,
     /// Exact normals, read back from a text file in f64 (spheres near and far from the origin).
@@ -101,13 +105,14 @@ pub enum Variant {
 }
 
 impl Variant {
-    pub const SAMPLED: [Variant; 3] = [Variant::Clean, Variant::NoNormals, Variant::Noisy];
+    pub const SAMPLED: [Variant; 4] = [Variant::Clean, Variant::NoNormals, Variant::Noisy, Variant::VeryNoisy];
 
     pub fn name(self) -> &'static str {
         match self {
             Variant::Clean => "clean",
             Variant::NoNormals => "no normals",
             Variant::Noisy => "noise 0.25%",
+            Variant::VeryNoisy => "noise 0.5%",
             Variant::Open => "open",
             Variant::Text => "f64 text",
         }
@@ -119,6 +124,7 @@ impl Variant {
             Variant::Clean => "clean",
             Variant::NoNormals => "nonormals",
             Variant::Noisy => "noisy",
+            Variant::VeryNoisy => "noisy05",
             Variant::Open => "open",
             Variant::Text => "text",
         }
@@ -187,6 +193,7 @@ pub fn sampled(truth: &Truth, count: usize, variant: Variant) -> Mesh {
     match variant {
         Variant::NoNormals => cloud.normals = None,
         Variant::Noisy => add_noise(&mut cloud, NOISE * truth.diagonal, 0.0, NOISE_SEED),
+        Variant::VeryNoisy => add_noise(&mut cloud, HIGH_NOISE * truth.diagonal, 0.0, NOISE_SEED),
         _ => {}
     }
     cloud

@@ -1,7 +1,7 @@
 //! Reconstruction on shapes nothing was tuned on: points sampled on the 16 closed meshes of
 //! `../shared/data/corpus` and on the closed meshes of `../shared/data`, at each size, with
-//! exact normals, without normals and with noisy positions; and synthetic cases with a known
-//! answer (an open hemisphere, single-view scans of corpus meshes, a unit sphere at the origin
+//! exact normals, without normals and with positions noisy by 0.25% and 0.5% of the diagonal;
+//! and synthetic cases with a known answer (an open hemisphere, single-view scans of corpus meshes, a unit sphere at the origin
 //! and far from it). Every output, vstree's and with `--peers` screened Poisson's (PyMeshLab
 //! and Open3D, depth 8 and 10, on the same points with the same normals), is measured by the
 //! same code against the mesh the points came from: genus and components, Chamfer and
@@ -41,7 +41,8 @@ usage: cargo bench --bench corpus -- [options]
   --sizes A,B           points sampled on each mesh (default 200000,1000000)
   --models A,B          only these meshes (stems; default: the 16 of the corpus and the closed
                         ones of the data directory; or none); single views only of those among them
-  --variants A,B        only these samplings of the meshes: clean, nonormals, noisy (default: all)
+  --variants A,B        only these samplings of the meshes: clean, nonormals, noisy (0.25% of the
+                        diagonal), noisy05 (0.5%) (default: all)
   --quick               20k points, 3 models (bull, femur, triceratops), small synthetic cases
   --reduced             sizes above the smallest only for the corpus's clean variant
   --no-synthetic        skip the hemisphere, single views and spheres
@@ -167,7 +168,7 @@ impl Options {
             return Err(format!("unknown peer {bad}: the peers are {}", known.join(", ")));
         }
         if let Some(bad) = o.variants.iter().flatten().find(|v| !Variant::SAMPLED.iter().any(|k| k.file_name() == *v)) {
-            return Err(format!("unknown variant {bad}: the variants are clean, nonormals, noisy"));
+            return Err(format!("unknown variant {bad}: the variants are clean, nonormals, noisy, noisy05"));
         }
         let models = inputs::models(&o.data);
         if let Some(bad) = o.models.iter().flatten().find(|m| !models.iter().any(|k| k.name == **m)) {
