@@ -707,7 +707,12 @@ fn print_reconstruct(
     print_tree(&s.tree)?;
     let genus = s.base_genus.map_or("not a closed manifold".to_string(), |g| format!("genus {g}"));
     let thickened = if s.thickened { " (thickened: the plain one had handles through thin parts)" } else { "" };
-    say!("grid: {} cells across, {} triangles polygonised{thickened}", s.grid_cells, s.fine_triangles);
+    say!(
+        "grid: {} cells across, {} triangles polygonised{thickened}, field evaluated at {} points",
+        s.grid_cells,
+        s.fine_triangles,
+        s.field_evaluations
+    );
     say!("M0: {} vertices, {} triangles, {genus}, error {:.2e}", s.base_vertices, s.base_triangles, s.base_error);
     for (k, level) in s.levels.iter().enumerate() {
         say!("level {}: {} new vertices, {} displaced by the quadtrees", k + 1, level.new_vertices, level.displaced);

@@ -51,6 +51,7 @@ use crate::topology;
 use crate::tree::{self, NodeKind, TreeParams, TreeSample, VsTree};
 use glam::Vec3;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// At most this many samples are measured for error(M, S).
@@ -262,7 +263,9 @@ pub fn reconstruct(
     // Open asked for; `Auto` first polygonises as for a closed output and, if that finds an
     // open scan, again as for an open one.
     let asked_open = params.closure == Closure::Open || params.trim > 0.0;
+    let evaluations = AtomicUsize::new(0);
     let f = |p: Vec3, open: bool| {
+        evaluations.fetch_add(1, Ordering::Relaxed);
         let inside_above = if open { OPEN_SCAN_INSIDE } else { 0.5 };
         match params.base_mesh {
             BaseMesh::Winding => {
@@ -359,6 +362,7 @@ pub fn reconstruct(
     let Polygonised { mut fine, thickened, neighbours, labels, unsupported, .. } = part;
     stats.thickened = thickened;
     stats.fine_triangles = fine.triangles.len();
+    stats.field_evaluations = evaluations.load(Ordering::Relaxed);
     let neighbours = if stats.open {
         // An open M0 is made of the supported part only: the closing sheet never joins a
         // T-node's cluster.

@@ -198,6 +198,8 @@ pub struct ReconstructStats {
     /// Cells across the polygonisation grid (a power of two).
     pub grid_cells: u32,
     pub fine_triangles: usize,
+    /// Points where the base mesh's implicit function (inside or outside) was evaluated.
+    pub field_evaluations: usize,
     /// The polygonisation was thickened (see the `reconstruct` module): the plain one had
     /// handles that vanished once parts thinner than the grid were thickened.
     pub thickened: bool,
