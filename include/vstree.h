@@ -70,7 +70,7 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 5
+#define VSTREE_VERSION_MINOR 6
 
 /**
  * Patch version (semver).
@@ -119,6 +119,12 @@
  * `base_mesh` value: the paper's blend of the T-nodes' planes near the points.
  */
 #define VSTREE_BASE_MESH_PAPER 1
+
+/**
+ * `base_mesh` value: the winding number's side, polygonised over the tree's octree with each
+ * region at its own T-node's size instead of on a grid as fine as the smallest. Since 0.6.0.
+ */
+#define VSTREE_BASE_MESH_ADAPTIVE 2
 
 /**
  * `closure` value: open when more than 30% of the closed surface is unsupported by the points

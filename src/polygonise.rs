@@ -327,7 +327,7 @@ pub(crate) fn polygonise_grid(f: impl Fn(Vec3) -> f32 + Sync, grid: &Grid) -> Me
 
 /// A fast hasher for the packed grid keys (multiplicative, like FxHash, rotated at the end).
 #[derive(Default)]
-struct KeyHasher(u64);
+pub(crate) struct KeyHasher(u64);
 
 impl Hasher for KeyHasher {
     fn write(&mut self, bytes: &[u8]) {
@@ -350,7 +350,7 @@ impl Hasher for KeyHasher {
     }
 }
 
-type FastMap<K, V> = HashMap<K, V, BuildHasherDefault<KeyHasher>>;
+pub(crate) type FastMap<K, V> = HashMap<K, V, BuildHasherDefault<KeyHasher>>;
 type FastSet<K> = HashSet<K, BuildHasherDefault<KeyHasher>>;
 
 /// The six faces of a cube: the axis bit, and whether it is the face where that bit is set.

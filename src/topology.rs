@@ -226,6 +226,28 @@ pub fn analyze(mesh: &Mesh) -> TopologyReport {
     report
 }
 
+/// Per vertex of a mesh of `vertex_count` vertices: whether the faces around it form more than
+/// one disk or half-disk, or one of its edges has more than two faces.
+pub(crate) fn non_manifold_vertices(triangles: &[[u32; 3]], vertex_count: usize) -> Vec<bool> {
+    let mut flagged = vec![false; vertex_count];
+    for ((a, b), faces) in edges_and_face_counts(triangles) {
+        if faces > 2 {
+            flagged[a as usize] = true;
+            flagged[b as usize] = true;
+        }
+    }
+    let mut fans: Vec<Vec<u32>> = vec![Vec::new(); vertex_count];
+    for (f, t) in triangles.iter().enumerate() {
+        for &v in t {
+            fans[v as usize].push(f as u32);
+        }
+    }
+    for (v, fan) in fans.iter().enumerate() {
+        flagged[v] |= !fan.is_empty() && !is_single_fan(v as u32, fan, triangles);
+    }
+    flagged
+}
+
 /// True when the faces `fan` around vertex `v` form one disk or half-disk: in the *link* of `v`
 /// (each face contributes the edge between its two other vertices) every vertex has degree at
 /// most 2 and the link is connected, so it is a single cycle or a single path.

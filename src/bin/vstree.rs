@@ -281,6 +281,9 @@ enum BaseMeshArg {
     Winding,
     /// The paper's construction: the T-nodes' planes blended near the points (to compare with).
     Paper,
+    /// The winding number's side, polygonised over the tree's octree, each region at its own
+    /// T-node's size (the field evaluated at the T-layer's corners, not on a fine grid).
+    Adaptive,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -504,6 +507,7 @@ fn run(command: Command) -> vstree::Result<()> {
                 base_mesh: match base_mesh {
                     BaseMeshArg::Winding => BaseMesh::Winding,
                     BaseMeshArg::Paper => BaseMesh::Paper,
+                    BaseMeshArg::Adaptive => BaseMesh::Adaptive,
                 },
                 threads,
                 ..ReconstructParams::default()
@@ -707,12 +711,12 @@ fn print_reconstruct(
     print_tree(&s.tree)?;
     let genus = s.base_genus.map_or("not a closed manifold".to_string(), |g| format!("genus {g}"));
     let thickened = if s.thickened { " (thickened: the plain one had handles through thin parts)" } else { "" };
-    say!(
-        "grid: {} cells across, {} triangles polygonised{thickened}, field evaluated at {} points",
-        s.grid_cells,
-        s.fine_triangles,
-        s.field_evaluations
-    );
+    let polygonised = if s.on_grid {
+        format!("grid: {} cells across, {} triangles polygonised{thickened}", s.grid_cells, s.fine_triangles)
+    } else {
+        format!("octree: {} triangles polygonised over the T-layer", s.fine_triangles)
+    };
+    say!("{polygonised}, field evaluated at {} points", s.field_evaluations);
     say!("M0: {} vertices, {} triangles, {genus}, error {:.2e}", s.base_vertices, s.base_triangles, s.base_error);
     for (k, level) in s.levels.iter().enumerate() {
         say!("level {}: {} new vertices, {} displaced by the quadtrees", k + 1, level.new_vertices, level.displaced);

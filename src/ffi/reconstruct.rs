@@ -85,6 +85,9 @@ pub struct vstree_reconstruct_params {
 pub const VSTREE_BASE_MESH_WINDING: i32 = 0;
 /// `base_mesh` value: the paper's blend of the T-nodes' planes near the points.
 pub const VSTREE_BASE_MESH_PAPER: i32 = 1;
+/// `base_mesh` value: the winding number's side, polygonised over the tree's octree with each
+/// region at its own T-node's size instead of on a grid as fine as the smallest. Since 0.6.0.
+pub const VSTREE_BASE_MESH_ADAPTIVE: i32 = 2;
 
 /// `closure` value: open when more than 30% of the closed surface is unsupported by the points
 /// (far from all, or near only points facing the other way; a scan from one side leaves about
@@ -116,6 +119,7 @@ fn base_mesh(value: i32) -> FfiResult<BaseMesh> {
         &[
             (VSTREE_BASE_MESH_WINDING, "VSTREE_BASE_MESH_WINDING", BaseMesh::Winding),
             (VSTREE_BASE_MESH_PAPER, "VSTREE_BASE_MESH_PAPER", BaseMesh::Paper),
+            (VSTREE_BASE_MESH_ADAPTIVE, "VSTREE_BASE_MESH_ADAPTIVE", BaseMesh::Adaptive),
         ],
     )
 }
@@ -125,6 +129,7 @@ fn base_mesh_value(base_mesh: BaseMesh) -> i32 {
     match base_mesh {
         BaseMesh::Winding => VSTREE_BASE_MESH_WINDING,
         BaseMesh::Paper => VSTREE_BASE_MESH_PAPER,
+        BaseMesh::Adaptive => VSTREE_BASE_MESH_ADAPTIVE,
     }
 }
 
@@ -492,7 +497,7 @@ mod tests {
             ("reorient_given", |p| p.reorient_given = 7),
             ("threads", |p| p.threads = u32::MAX),
             ("closure", |p| p.closure = 3),
-            ("base_mesh", |p| p.base_mesh = 2),
+            ("base_mesh", |p| p.base_mesh = 3),
         ];
         for (field, spoil) in cases {
             let mut p = vstree_reconstruct_params_default();

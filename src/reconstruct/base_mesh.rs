@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use std::collections::VecDeque;
 
 /// No T-node.
-const UNLABELLED: u32 = u32::MAX;
+pub(crate) const UNLABELLED: u32 = u32::MAX;
 
 /// The T-node whose cube contains `p`, if the octree's descent reaches one.
 pub(crate) fn t_node_at(tree: &VsTree, p: Vec3) -> Option<u32> {
@@ -34,7 +34,13 @@ pub(crate) fn t_node_at(tree: &VsTree, p: Vec3) -> Option<u32> {
 /// A T-node for every vertex: the one whose cube holds it, or else (the vertex lies in an empty
 /// cell) the label of the nearest labelled vertex along the mesh's edges.
 pub(crate) fn label_vertices(tree: &VsTree, mesh: &Mesh, neighbours: &Rows) -> Vec<u32> {
-    let mut labels: Vec<u32> = mesh.positions.par_iter().map(|&p| t_node_at(tree, p).unwrap_or(UNLABELLED)).collect();
+    let labels: Vec<u32> = mesh.positions.par_iter().map(|&p| t_node_at(tree, p).unwrap_or(UNLABELLED)).collect();
+    spread_labels(labels, neighbours)
+}
+
+/// Gives every vertex without a T-node ([`UNLABELLED`]) the label of the nearest labelled vertex
+/// along the mesh's edges.
+pub(crate) fn spread_labels(mut labels: Vec<u32>, neighbours: &Rows) -> Vec<u32> {
     let mut queue: VecDeque<u32> = (0..labels.len() as u32).filter(|&v| labels[v as usize] != UNLABELLED).collect();
     while let Some(v) = queue.pop_front() {
         for &w in neighbours.of(v) {

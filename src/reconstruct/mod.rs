@@ -25,6 +25,7 @@
 
 mod adjacency;
 mod base_mesh;
+mod dual_contour;
 mod implicit;
 mod leaf_fit;
 mod mls;
@@ -251,7 +252,7 @@ pub fn reconstruct(
     // A sparse cloud's leaves are smaller than the surface their few samples stand for: each
     // sample stands for at least a square of the spacing (exactly that on a regular grid).
     let (softening, min_sample_area) = match params.base_mesh {
-        BaseMesh::Winding => (WINDING_SOFTENING * spacing, spacing * spacing),
+        BaseMesh::Winding | BaseMesh::Adaptive => (WINDING_SOFTENING * spacing, spacing * spacing),
         BaseMesh::Paper => (0.0, 0.0),
     };
     let winding = winding::WindingNumber::new(&tree, min_sample_area).softened(softening);
@@ -268,7 +269,7 @@ pub fn reconstruct(
         evaluations.fetch_add(1, Ordering::Relaxed);
         let inside_above = if open { OPEN_SCAN_INSIDE } else { 0.5 };
         match params.base_mesh {
-            BaseMesh::Winding => {
+            BaseMesh::Winding | BaseMesh::Adaptive => {
                 let d = sample_index.distance_within(p, side_only_beyond).min(side_only_beyond);
                 let w = winding.at(p);
                 let inside = if open && d <= planes_within && (w - 0.5).abs() < WINDING_DOUBT {
@@ -307,24 +308,23 @@ pub fn reconstruct(
     let sample_normals: Vec<Vec3> = tree.samples.iter().map(|s| s.normal).collect();
     let smallest_hole = f64::from(2.0 * typical_t_half).powi(2);
     let polygonised = |open: bool| -> Result<Polygonised> {
-        let mut fine = polygonise(0.0, open)?;
-        let mut thickened = false;
-        let genus = topology::closed_surface_genus(&fine);
-        if genus > 0 {
-            // Handles may be perforations of parts thinner than the grid resolves (see
-            // THICKEN_CELLS): if the thickened surface has fewer, they were.
-            // A thickened surface too large for the grid budget is no reason to fail: the
-            // plain one stands.
-            if let Ok(thick) = polygonise(THICKEN_CELLS * grid.cell, open) {
-                if !thick.triangles.is_empty() && topology::closed_surface_genus(&thick) < genus {
-                    fine = thick;
-                    thickened = true;
-                }
+        // Where the adaptive polygonisation cannot make a 2-manifold even with its finest
+        // leaves (sheets closer than the samples resolve), the grid's is used.
+        let contour = match params.base_mesh {
+            BaseMesh::Adaptive => dual_contour::contour(&tree, &|p| f(p, open), distance_unit, &threads),
+            _ => None,
+        };
+        let on_grid = contour.is_none();
+        let (mut fine, labels, thickened) = match contour {
+            Some(c) => (Mesh::new(c.positions, None, c.triangles), Some(c.labels), false),
+            None => {
+                let (fine, thickened) = polygonise_on_grid(&|cells| polygonise(cells * grid.cell, open))?;
+                (fine, None, thickened)
             }
-        }
+        };
         if fine.triangles.is_empty() {
             return Err(Error::input(match params.base_mesh {
-                BaseMesh::Winding => format!(
+                BaseMesh::Winding | BaseMesh::Adaptive => format!(
                     "the points enclose no volume: their winding number stays below one half everywhere \
                      near them ({})",
                     too_sparse_or_unoriented
@@ -339,17 +339,28 @@ pub fn reconstruct(
         if thickened {
             move_inward(&mut fine, &neighbours, THICKEN_CELLS * grid.cell, &threads);
         }
-        let labels = threads.run(|| base_mesh::label_vertices(&tree, &fine, &neighbours));
+        let labels = match labels {
+            Some(labels) => base_mesh::spread_labels(labels, &neighbours),
+            None => threads.run(|| base_mesh::label_vertices(&tree, &fine, &neighbours)),
+        };
         let reach = support::SUPPORT_REACH * distance_unit;
-        let face_reach =
-            |f: usize| reach + sag.get(labels[fine.triangles[f][0] as usize] as usize).copied().unwrap_or(0.0);
+        // A face of the adaptive polygonisation spans whole T-nodes, so its centre is as far
+        // from the surface as a chord of that length sags: up to half its longest edge.
+        let chord = |f: usize| {
+            let [a, b, c] = fine.triangles[f].map(|v| fine.positions[v as usize]);
+            0.5 * a.distance(b).max(b.distance(c)).max(c.distance(a))
+        };
+        let face_reach = |f: usize| {
+            let sag = sag.get(labels[fine.triangles[f][0] as usize] as usize).copied().unwrap_or(0.0);
+            reach + sag + if params.base_mesh == BaseMesh::Adaptive { chord(f) } else { 0.0 }
+        };
         let support = support::supported_faces(&fine, &sample_index, &sample_normals, face_reach, &threads);
         // Faces that no sample supports: far from all, or near only samples facing the other
         // way (the closing sheet right behind an open scan).
         let unsupported: Vec<bool> = support.iter().map(|&s| s != support::Support::Supported).collect();
         let unsupported = support::without_small_regions(&fine, &unsupported, smallest_hole);
         let share = support::unsupported_share(&fine, &unsupported);
-        Ok(Polygonised { fine, thickened, neighbours, labels, unsupported, share })
+        Ok(Polygonised { fine, thickened, on_grid, neighbours, labels, unsupported, share })
     };
     let mut part = polygonised(asked_open)?;
     stats.unsupported_share = part.share;
@@ -359,8 +370,9 @@ pub fn reconstruct(
     }
     drop((sample_normals, sag));
     progress.report(0.4, "base mesh")?;
-    let Polygonised { mut fine, thickened, neighbours, labels, unsupported, .. } = part;
+    let Polygonised { mut fine, thickened, on_grid, neighbours, labels, unsupported, .. } = part;
     stats.thickened = thickened;
+    stats.on_grid = on_grid;
     stats.fine_triangles = fine.triangles.len();
     stats.field_evaluations = evaluations.load(Ordering::Relaxed);
     let neighbours = if stats.open {
@@ -501,6 +513,8 @@ struct Polygonised {
     fine: Mesh,
     /// Thickened: see `THICKEN_CELLS`.
     thickened: bool,
+    /// Made on the uniform grid rather than over the tree's octree.
+    on_grid: bool,
     neighbours: adjacency::Rows,
     /// The T-node each vertex is clustered into.
     labels: Vec<u32>,
@@ -580,6 +594,24 @@ fn polygonisation_grid(tree: &VsTree, max_depth: u32, spacing: f32) -> Grid {
     let cell = 2.0 * root.half / cells as f32;
     let points = cells + 5;
     Grid { origin: root.center - root.half - 2.0 * cell, cell, dims: [points; 3] }
+}
+
+/// The grid polygonisation (`polygonise(offset)` makes it `offset` grid cells outside the zero set), and
+/// whether it was thickened: where it has handles, the thickened one is kept if it has fewer
+/// (see `THICKEN_CELLS`; the caller moves its vertices back).
+fn polygonise_on_grid(polygonise: &dyn Fn(f32) -> Result<Mesh>) -> Result<(Mesh, bool)> {
+    let fine = polygonise(0.0)?;
+    let genus = topology::closed_surface_genus(&fine);
+    if genus > 0 {
+        // A thickened surface too large for the grid budget is no reason to fail: the plain
+        // one stands.
+        if let Ok(thick) = polygonise(THICKEN_CELLS) {
+            if !thick.triangles.is_empty() && topology::closed_surface_genus(&thick) < genus {
+                return Ok((thick, true));
+            }
+        }
+    }
+    Ok((fine, false))
 }
 
 /// Moves every vertex `distance` against its normal: back from the offset the polygonisation

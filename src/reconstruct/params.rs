@@ -19,6 +19,10 @@ pub enum BaseMesh {
     /// The paper's §5.2: the T-nodes' planes blended by a partition of unity near the samples
     /// (the winding number only decides beyond them). Kept to compare with.
     Paper,
+    /// The winding number's side, polygonised over the tree's own octree with the T-nodes as
+    /// cells (dual contouring, see `dual_contour`) instead of on a grid as fine as the deepest
+    /// T-node: each region at its own T-node's size, the field evaluated at the T-layer's corners.
+    Adaptive,
 }
 
 /// Parameters of [`super::reconstruct`].
@@ -203,6 +207,9 @@ pub struct ReconstructStats {
     /// The polygonisation was thickened (see the `reconstruct` module): the plain one had
     /// handles that vanished once parts thinner than the grid were thickened.
     pub thickened: bool,
+    /// The base mesh was polygonised on the uniform grid: asked for, or the adaptive
+    /// polygonisation ([`BaseMesh::Adaptive`]) could not make a 2-manifold.
+    pub on_grid: bool,
     /// Share of the polygonised closed surface's area no sample supports: farther than the
     /// support's reach from every sample, or near only samples facing the other way (about
     /// half for a scan from one side).

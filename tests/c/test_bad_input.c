@@ -851,7 +851,7 @@ RECONSTRUCT_PARAM(reconstruct_neighbours_2, neighbours, 2)
 RECONSTRUCT_PARAM(reconstruct_neighbours_257, neighbours, 257)
 RECONSTRUCT_PARAM(reconstruct_reorient_2, reorient_given, 2)
 RECONSTRUCT_PARAM(reconstruct_threads_1025, threads, 1025)
-RECONSTRUCT_PARAM(reconstruct_base_mesh_2, base_mesh, 2)
+RECONSTRUCT_PARAM(reconstruct_base_mesh_3, base_mesh, 3)
 
 /* vstree_estimate_normals and its parameters */
 CALL(normals_mesh_null) { return normals_with(NULL, NULL, NULL); }
@@ -1740,9 +1740,9 @@ static const bad_case g_cases[] = {
         "vstree_reconstruct: parameter `reorient_given`: 2: must be 0 or 1"),
     ROW(reconstruct_threads_1025, INVALID_PARAMETER,
         "vstree_reconstruct: parameter `threads`: 1025: must be 0 (all cores) to 1024"),
-    ROW(reconstruct_base_mesh_2, INVALID_PARAMETER,
-        "vstree_reconstruct: parameter `base_mesh`: 2: must be one of 0 (VSTREE_BASE_MESH_WINDING), "
-        "1 (VSTREE_BASE_MESH_PAPER)"),
+    ROW(reconstruct_base_mesh_3, INVALID_PARAMETER,
+        "vstree_reconstruct: parameter `base_mesh`: 3: must be one of 0 (VSTREE_BASE_MESH_WINDING), "
+        "1 (VSTREE_BASE_MESH_PAPER), 2 (VSTREE_BASE_MESH_ADAPTIVE)"),
 
     ROW(normals_mesh_null, NULL_POINTER, "vstree_estimate_normals: `mesh` is NULL"),
     ROW(normals_out_null, NULL_POINTER, "vstree_estimate_normals: `out_mesh` is NULL"),

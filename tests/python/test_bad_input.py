@@ -407,7 +407,7 @@ PARAMETER_CASES = [
     case("reconstruct-closure-unknown", reconstruct_with(closure="half"), ValueError, None,
          "vstree.reconstruct: parameter `closure`: 'half' is not one of 'auto', 'closed', 'open'"),
     case("reconstruct-base-mesh-unknown", reconstruct_with(base_mesh="poisson"), ValueError, None,
-         "vstree.reconstruct: parameter `base_mesh`: 'poisson' is not one of 'paper', 'winding'"),
+         "vstree.reconstruct: parameter `base_mesh`: 'poisson' is not one of 'adaptive', 'paper', 'winding'"),
     # estimate_normals
     case("normals-neighbours-too-many", normals_with(neighbours=300), vstree.VstreeError, BAD,
          "vstree_estimate_normals: parameter `neighbours`: 300: must be from 3 to 256"),

@@ -426,7 +426,7 @@ _METRICS = {"l2": 0, "l21": 1, "density": 2}
 _SAMPLINGS = {"vertices": 0, "faces": 1, "face_centers": 1}
 _ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
 _CLOSURES = {"auto": 0, "closed": 1, "open": 2}
-_BASE_MESHES = {"winding": 0, "paper": 1}
+_BASE_MESHES = {"winding": 0, "paper": 1, "adaptive": 2}
 _KEEP_TOPOLOGY = {"auto": 0, "on": 1, "off": 2}
 _ENUMS = {
     "tree_kind": _TREE_KINDS,
@@ -716,7 +716,8 @@ def reconstruct(cloud, normals=None, progress=None, **params):
     "closed": always closed, holes closed over | "open": only the part of the surface the
     points support, holes kept), ``base_mesh`` ("winding", the
     default: the points' winding number decides inside and outside | "paper": the paper's
-    blended T-node planes), ``trim`` (grid cells: every face farther goes; 0, the default,
+    blended T-node planes | "adaptive": the winding number's side polygonised over the tree's
+    octree, each region at its own T-node's size), ``trim`` (grid cells: every face farther goes; 0, the default,
     trims only past an open scan's border), ``d_a``, ``d_d``, ``max_depth``, ``min_cell_size``, ``orient``
     ("propagate_outward" | "propagate" | "propagate_majority" | "unoriented"), ``neighbours``,
     ``reorient_given``, ``threads``.
