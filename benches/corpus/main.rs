@@ -11,7 +11,8 @@
 //! ```text
 //! cargo bench --bench corpus -- [--peers] [--sizes 200000,1000000] [--models bear,igea] [--quick]
 //!     [--reduced] [--no-synthetic] [--methods open3d-poisson8] [--runs N] [--peer-runs N]
-//!     [--max-peer-points N] [--data ../shared/data] [--threads N] [--clouds] [--no-write]
+//!     [--max-peer-points N] [--data ../shared/data] [--threads N] [--base-mesh NAME] [--clouds]
+//!     [--no-write]
 //! ```
 
 #[path = "../common/mod.rs"]
@@ -53,8 +54,8 @@ usage: cargo bench --bench corpus -- [options]
   --max-peer-points N   skip the peers on clouds with more points (default 2000000)
   --data DIR            data directory (default ../shared/data, relative to the project root)
   --threads N           vstree's worker threads, 0 = all cores (default 0)
-  --base-mesh paper     vstree's base mesh from the paper's blended T-node planes instead of the
-                        default winding number (to compare the two)
+  --base-mesh NAME      vstree's base mesh (default: the library's default); an unknown name lists
+                        the names
   --clouds              also write each input cloud (target/bench-corpus/<row>-cloud.ply), to rerun
                         a row with the CLI
   --no-write            print the report only, do not update docs/benchmarks.md";
@@ -66,6 +67,22 @@ pub const OPEN_PEERS: [&str; 2] = ["open3d-poisson8-trim", "open3d-poisson10-tri
 const HEMISPHERES: [usize; 2] = [10_000, 200_000];
 const SYNTHETIC: usize = 200_000;
 const QUICK_POINTS: usize = 20_000;
+
+/// vstree's base meshes by their `--base-mesh` name, with what the report's notes say of each.
+const BASE_MESHES: [(&str, BaseMesh, &str); 2] = [
+    ("winding", BaseMesh::Winding, "the samples' winding number and distance, on a grid as fine as the deepest T-node"),
+    ("paper", BaseMesh::Paper, "the paper's blended T-node planes near the samples, the winding number beyond"),
+];
+
+/// The base mesh of a `--base-mesh` name.
+pub fn base_mesh(name: &str) -> Option<BaseMesh> {
+    BASE_MESHES.iter().find(|(n, _, _)| *n == name).map(|&(_, b, _)| b)
+}
+
+/// The `--base-mesh` name of a base mesh and what it is.
+fn base_mesh_name(base: BaseMesh) -> (&'static str, &'static str) {
+    BASE_MESHES.iter().find(|(_, b, _)| *b == base).map_or(("?", "not named in the bench"), |&(n, _, what)| (n, what))
+}
 
 /// Command-line options.
 pub struct Options {
@@ -137,11 +154,11 @@ impl Options {
                 "--threads" => o.threads = number(value()?)?,
                 "--data" => o.data = PathBuf::from(value()?),
                 "--base-mesh" => {
-                    o.base_mesh = match value()?.as_str() {
-                        "paper" => BaseMesh::Paper,
-                        "winding" => BaseMesh::Winding,
-                        v => return Err(format!("--base-mesh {v}: paper or winding")),
-                    }
+                    let v = value()?;
+                    o.base_mesh = base_mesh(v).ok_or_else(|| {
+                        let names: Vec<&str> = BASE_MESHES.iter().map(|(n, _, _)| *n).collect();
+                        format!("--base-mesh {v}: the base meshes are {}", names.join(", "))
+                    })?;
                 }
                 other => return Err(format!("unknown option {other}\n{USAGE}")),
             }
@@ -269,9 +286,9 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     let synthetic = if o.synthetic { o.hemispheres().len() + 1 + inputs::OFFSETS.len() } else { 0 };
     let total = models.iter().map(|m| o.samplings(m.corpus).len()).sum::<usize>() + views.len() + synthetic;
     let mut bench = Bench { o, root, out_dir, clock, rows: Vec::new(), notes: Vec::new(), done: 0, total };
-    if o.base_mesh == BaseMesh::Paper {
-        bench.notes.push("vstree's base mesh: the paper's blended T-node planes (`--base-mesh paper`).".into());
-    }
+    let (name, what) = base_mesh_name(o.base_mesh);
+    let default = if o.base_mesh == BaseMesh::default() { ", the library's default" } else { "" };
+    bench.notes.push(format!("vstree's base mesh: `--base-mesh {name}`{default}: {what}."));
 
     let mut skipped = Vec::new();
     for model in &models {
