@@ -5,8 +5,8 @@
 //! kernel's peak-RSS counter with `echo 5 > /proc/self/clear_refs`, Linux 4.0+, and notes the
 //! resident size: the baseline, i.e. the input plus the program), does the work, and calls
 //! [`Probe::report`], which prints the peak resident size (`VmHWM` in `/proc/self/status`).
-//! glibc is told to keep a fixed mmap threshold so that blocks freed before the work (e.g. the
-//! mesh a cloud was drawn on) really leave the process.
+//! glibc can be told to keep a fixed mmap threshold so that blocks freed before the work (e.g.
+//! the mesh a cloud was drawn on) really leave the process.
 
 use std::process::Command;
 
@@ -70,21 +70,28 @@ impl Probe {
 /// Runs this bench again with `args` (which must make it a child that uses [`Probe`]) and reads
 /// its report.
 pub fn run_child(args: &[String]) -> Result<Peak, String> {
+    run_child_output(args, true).map(|(peak, _)| peak)
+}
+
+/// [`run_child`], also returning the child's whole stdout (its other lines). With
+/// `fixed_mmap_threshold`, glibc keeps a fixed mmap threshold in the child, so big blocks freed
+/// before the work go back to the kernel instead of padding the baseline; without it the child
+/// allocates as any program does (for work that is timed too).
+pub fn run_child_output(args: &[String], fixed_mmap_threshold: bool) -> Result<(Peak, String), String> {
     let exe = std::env::current_exe().map_err(|e| e.to_string())?;
-    let output = Command::new(exe)
-        .args(args)
-        // A fixed mmap threshold turns off glibc's dynamic one, so big blocks freed before the
-        // work go back to the kernel instead of padding the baseline.
-        .env("MALLOC_MMAP_THRESHOLD_", "131072")
-        .output()
-        .map_err(|e| e.to_string())?;
-    let text = String::from_utf8_lossy(&output.stdout);
+    let mut command = Command::new(exe);
+    command.args(args);
+    if fixed_mmap_threshold {
+        command.env("MALLOC_MMAP_THRESHOLD_", "131072");
+    }
+    let output = command.output().map_err(|e| e.to_string())?;
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
     let line = text.lines().find_map(|l| l.strip_prefix("memory ")).ok_or_else(|| {
         format!("no report from the child ({}): {}", output.status, String::from_utf8_lossy(&output.stderr).trim())
     })?;
     let fields: Vec<u64> = line.split_whitespace().filter_map(|f| f.parse().ok()).collect();
     match fields[..] {
-        [baseline, peak, reset] if peak > 0 => Ok(Peak { baseline, peak, reset: reset == 1 }),
+        [baseline, peak, reset] if peak > 0 => Ok((Peak { baseline, peak, reset: reset == 1 }, text)),
         _ => Err(format!("unreadable report from the child: {line}")),
     }
 }

@@ -37,6 +37,8 @@ pub fn reconstruction(cloud: &Mesh, params: &ReconstructParams, runs: usize) -> 
     let mut times: [Vec<f64>; 6] = Default::default();
     let mut last = None;
     for _ in 0..runs.max(1) {
+        // The previous run's output is dropped before the next run, outside its timed span.
+        drop(last.take());
         let start = Instant::now();
         let (mesh, stats) = reconstruct(cloud, params, &mut Progress::none())?;
         let total = start.elapsed().as_secs_f64();
@@ -51,7 +53,7 @@ pub fn reconstruction(cloud: &Mesh, params: &ReconstructParams, runs: usize) -> 
         for (t, s) in times.iter_mut().zip(stages) {
             t.push(s);
         }
-        last = Some((mesh, stats)); // the previous run's output is dropped outside the timed span
+        last = Some((mesh, stats));
     }
     let [normals, tree, base, refine, trim, total] = times.map(|t| median(&t));
     let (mesh, stats) = last.expect("at least one run");

@@ -5,6 +5,7 @@
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use vstree::eval::shapes::{add_noise, icosphere, sample_surface};
@@ -264,14 +265,23 @@ pub fn through_text(cloud: &Mesh, offset: DVec3, path: &Path) -> Result<Mesh, St
 }
 
 /// A mesh's positions relative to `offset` (where its truth is at the origin), computed in
-/// f64 from its own origin: what is measured against the truth.
-pub fn local(mesh: &Mesh, offset: DVec3) -> Mesh {
+/// f64 from its own origin: what is measured against the truth. A mesh already there is
+/// borrowed, not copied.
+pub fn local(mesh: &Mesh, offset: DVec3) -> Cow<'_, Mesh> {
     let shift = mesh.origin - offset;
+    if shift == DVec3::ZERO && mesh.origin == DVec3::ZERO {
+        return Cow::Borrowed(mesh);
+    }
     if shift == DVec3::ZERO {
-        return Mesh { origin: DVec3::ZERO, ..mesh.clone() };
+        return Cow::Owned(Mesh { origin: DVec3::ZERO, ..mesh.clone() });
     }
     let positions = mesh.positions.par_iter().map(|p| (shift + p.as_dvec3()).as_vec3()).collect();
-    Mesh { positions, normals: mesh.normals.clone(), triangles: mesh.triangles.clone(), origin: DVec3::ZERO }
+    Cow::Owned(Mesh {
+        positions,
+        normals: mesh.normals.clone(),
+        triangles: mesh.triangles.clone(),
+        origin: DVec3::ZERO,
+    })
 }
 
 /// An orthographic depth buffer of a mesh seen along [`VIEW`]: depth = position · view (larger

@@ -11,9 +11,13 @@
 //! ```text
 //! cargo bench --bench corpus -- [--peers] [--sizes 200000,1000000] [--models bear,igea] [--quick]
 //!     [--reduced] [--no-synthetic] [--methods open3d-poisson8] [--runs N] [--peer-runs N]
-//!     [--max-peer-points N] [--data ../shared/data] [--threads N] [--clouds] [--no-write]
+//!     [--max-peer-points N] [--data ../shared/data] [--threads N] [--base-mesh NAME] [--clouds]
+//!     [--no-write]
 //! ```
+//!
+//! vstree runs in a child process of its own (see `child`), which gives its peak memory too.
 
+mod child;
 #[path = "../common/mod.rs"]
 mod common;
 mod inputs;
@@ -22,7 +26,7 @@ mod report;
 
 use common::cli::{list, names, number, shown};
 use common::inputs::short_count;
-use common::reconstruction::{reconstruction, run_peers, Outcome};
+use common::reconstruction::{run_peers, Outcome};
 use common::report::Clock;
 use glam::DVec3;
 use inputs::{Truth, Variant};
@@ -40,7 +44,9 @@ usage: cargo bench --bench corpus -- [options]
                         density trimming
   --sizes A,B           points sampled on each mesh (default 200000,1000000)
   --models A,B          only these meshes (stems; default: the 16 of the corpus and the closed
-                        ones of the data directory; or none); single views only of those among them
+                        ones of the data directory; or none); single views only of those among them.
+                        One 10M row: --models bear --variants clean --sizes 10000000 --no-synthetic
+                        (with --peers, also --max-peer-points 10000000)
   --variants A,B        only these samplings of the meshes: clean, nonormals, noisy (0.25% of the
                         diagonal), noisy05 (0.5%) (default: all)
   --quick               20k points, 3 models (bull, femur, triceratops), small synthetic cases
@@ -53,9 +59,9 @@ usage: cargo bench --bench corpus -- [options]
   --max-peer-points N   skip the peers on clouds with more points (default 2000000)
   --data DIR            data directory (default ../shared/data, relative to the project root)
   --threads N           vstree's worker threads, 0 = all cores (default 0)
-  --base-mesh paper     vstree's base mesh from the paper's blended T-node planes instead of the
-                        default winding number (to compare the two)
-  --clouds              also write each input cloud (target/bench-corpus/<row>-cloud.ply), to rerun
+  --base-mesh NAME      vstree's base mesh (default: the library's default); an unknown name lists
+                        the names
+  --clouds              keep each input cloud (target/bench-corpus/<row>-cloud.ply), to rerun
                         a row with the CLI
   --no-write            print the report only, do not update docs/benchmarks.md";
 
@@ -66,6 +72,22 @@ pub const OPEN_PEERS: [&str; 2] = ["open3d-poisson8-trim", "open3d-poisson10-tri
 const HEMISPHERES: [usize; 2] = [10_000, 200_000];
 const SYNTHETIC: usize = 200_000;
 const QUICK_POINTS: usize = 20_000;
+
+/// vstree's base meshes by their `--base-mesh` name, with what the report's notes say of each.
+const BASE_MESHES: [(&str, BaseMesh, &str); 2] = [
+    ("winding", BaseMesh::Winding, "the samples' winding number and distance, on a grid as fine as the deepest T-node"),
+    ("paper", BaseMesh::Paper, "the paper's blended T-node planes near the samples, the winding number beyond"),
+];
+
+/// The base mesh of a `--base-mesh` name.
+pub fn base_mesh(name: &str) -> Option<BaseMesh> {
+    BASE_MESHES.iter().find(|(n, _, _)| *n == name).map(|&(_, b, _)| b)
+}
+
+/// The `--base-mesh` name of a base mesh and what it is.
+fn base_mesh_name(base: BaseMesh) -> (&'static str, &'static str) {
+    BASE_MESHES.iter().find(|(_, b, _)| *b == base).map_or(("?", "not named in the bench"), |&(n, _, what)| (n, what))
+}
 
 /// Command-line options.
 pub struct Options {
@@ -137,11 +159,11 @@ impl Options {
                 "--threads" => o.threads = number(value()?)?,
                 "--data" => o.data = PathBuf::from(value()?),
                 "--base-mesh" => {
-                    o.base_mesh = match value()?.as_str() {
-                        "paper" => BaseMesh::Paper,
-                        "winding" => BaseMesh::Winding,
-                        v => return Err(format!("--base-mesh {v}: paper or winding")),
-                    }
+                    let v = value()?;
+                    o.base_mesh = base_mesh(v).ok_or_else(|| {
+                        let names: Vec<&str> = BASE_MESHES.iter().map(|(n, _, _)| *n).collect();
+                        format!("--base-mesh {v}: the base meshes are {}", names.join(", "))
+                    })?;
                 }
                 other => return Err(format!("unknown option {other}\n{USAGE}")),
             }
@@ -216,6 +238,10 @@ impl Options {
 
 fn main() {
     let args = common::cli::bench_args();
+    if args.first().map(String::as_str) == Some("--vstree-child") {
+        child::child(&args[1..]);
+        return;
+    }
     common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let options = common::cli::or_exit(Options::parse(&args, &root));
@@ -269,9 +295,9 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     let synthetic = if o.synthetic { o.hemispheres().len() + 1 + inputs::OFFSETS.len() } else { 0 };
     let total = models.iter().map(|m| o.samplings(m.corpus).len()).sum::<usize>() + views.len() + synthetic;
     let mut bench = Bench { o, root, out_dir, clock, rows: Vec::new(), notes: Vec::new(), done: 0, total };
-    if o.base_mesh == BaseMesh::Paper {
-        bench.notes.push("vstree's base mesh: the paper's blended T-node planes (`--base-mesh paper`).".into());
-    }
+    let (name, what) = base_mesh_name(o.base_mesh);
+    let default = if o.base_mesh == BaseMesh::default() { ", the library's default" } else { "" };
+    bench.notes.push(format!("vstree's base mesh: `--base-mesh {name}`{default}: {what}."));
 
     let mut skipped = Vec::new();
     for model in &models {
@@ -370,47 +396,45 @@ impl Bench<'_> {
     }
 
     /// vstree's row of one case and, with `--peers`, the peers'.
-    fn measure(&mut self, case: Case) {
+    fn measure(&mut self, mut case: Case) {
         self.done += 1;
         let points = case.cloud.positions.len();
         let label = format!("{} {} {}", case.name, short_count(points), case.variant.name());
         eprintln!("corpus: [{}/{}, {:.0} s] {label}: vstree", self.done, self.total, self.clock.elapsed());
         let open = case.truth.open;
-        // Defaults on every input: open or closed is found, not told.
-        let params =
-            ReconstructParams { threads: self.o.threads, base_mesh: self.o.base_mesh, ..ReconstructParams::default() };
-        let local_cloud = inputs::local(&case.cloud, case.offset);
-        let samples = open.then(|| Samples::new(&local_cloud.positions));
         let stem = case.stem();
-        if self.o.clouds {
-            if let Err(e) = io::write(&self.out_dir.join(format!("{stem}-cloud.ply")), &case.cloud) {
-                eprintln!("corpus: cannot write the cloud: {e}");
-            }
-        }
-        let vstree = match reconstruction(&case.cloud, &params, self.o.runs) {
-            Ok(rec) => {
-                if let Err(e) = io::write(&self.out_dir.join(format!("{stem}-vstree.ply")), &rec.mesh) {
-                    eprintln!("corpus: cannot write vstree's output: {e}");
-                }
-                let q = quality(&inputs::local(&rec.mesh, case.offset), case.truth, samples.as_ref());
+        let samples = open.then(|| Samples::new(&inputs::local(&case.cloud, case.offset).positions));
+        // vstree's child and the peers read the cloud from this file; the bench's copy is
+        // dropped so that the cloud is not held twice while they run.
+        let cloud_path = self.out_dir.join(format!("{stem}-cloud.ply"));
+        let cloud = std::mem::take(&mut case.cloud);
+        let needs_normals = cloud.normals.is_none();
+        let written = io::write(&cloud_path, &cloud).map_err(|e| format!("cannot write the cloud: {e}"));
+        drop(cloud);
+        let output = self.out_dir.join(format!("{stem}-vstree.ply"));
+        let base_mesh = base_mesh_name(self.o.base_mesh).0;
+        let vstree = written
+            .and_then(|()| child::run(&cloud_path, &output, self.o.runs, self.o.threads, base_mesh))
+            .and_then(|run| {
+                let mesh = io::read(&output).map_err(|e| format!("cannot read vstree's output: {e}"))?;
+                let q = quality(&inputs::local(&mesh, case.offset), case.truth, samples.as_ref());
                 eprintln!(
-                    "corpus:   vstree {:.2} s, {} vertices, genus {:?} (truth {:?}), Chamfer {:.4}%, {} ({:.1}% unsupported), farthest face {:.1} spacings",
-                    rec.seconds.total,
+                    "corpus:   vstree {:.2} s, {:.0} bytes/point, {} vertices, genus {:?} (truth {:?}), Chamfer {:.4}%, {} ({:.1}% unsupported), farthest face {:.1} spacings",
+                    run.seconds.total,
+                    run.memory.total_per(points),
                     q.vertices,
                     q.genus,
                     case.truth.genus,
                     100.0 * q.distances.chamfer().unwrap_or(f64::NAN),
-                    if rec.stats.open { "open" } else { "closed" },
-                    100.0 * rec.stats.unsupported_share,
+                    if run.open { "open" } else { "closed" },
+                    100.0 * run.unsupported_share,
                     q.farthest_face.unwrap_or(f64::NAN)
                 );
-                Ok((rec.seconds, rec.stats.levels.len(), q))
-            }
-            Err(e) => {
-                eprintln!("corpus:   vstree failed: {e}");
-                Err(e.to_string())
-            }
-        };
+                Ok((run, q))
+            });
+        if let Err(e) = &vstree {
+            eprintln!("corpus:   vstree failed: {e}");
+        }
         let mut row = Row {
             name: case.name.clone(),
             variant: case.variant,
@@ -423,14 +447,25 @@ impl Bench<'_> {
             peers: Vec::new(),
         };
         if self.o.peers {
-            self.peers(&case, &params, &stem, samples.as_ref(), &mut row);
+            self.peers(&case, &cloud_path, needs_normals, &stem, samples.as_ref(), &mut row);
+        }
+        if !self.o.clouds {
+            let _ = std::fs::remove_file(&cloud_path);
         }
         self.rows.push(row);
         self.checkpoint();
     }
 
-    /// The peers on the case's points with the normals vstree uses.
-    fn peers(&mut self, case: &Case, params: &ReconstructParams, stem: &str, samples: Option<&Samples>, row: &mut Row) {
+    /// The peers on the case's points (in `cloud`) with the normals vstree uses.
+    fn peers(
+        &mut self,
+        case: &Case,
+        cloud: &Path,
+        needs_normals: bool,
+        stem: &str,
+        samples: Option<&Samples>,
+        row: &mut Row,
+    ) {
         let wanted = match &self.o.big_methods {
             Some(big) if row.points > self.o.sizes[0] => big,
             _ => &self.o.methods,
@@ -455,22 +490,25 @@ impl Bench<'_> {
             }));
             return;
         }
-        // The normals vstree uses: its own estimate where the cloud has none (deterministic,
-        // the same parameters), the given ones otherwise; written to a PLY file (in doubles
-        // for a cloud far from the origin) that every peer reads.
-        let mut oriented = case.cloud.clone();
-        let normal_params = NormalParams { threads: self.o.threads, ..params.normals };
-        if let Err(e) = ensure_normals(&mut oriented, &normal_params, &mut Progress::none()) {
-            self.notes.push(format!("Peers on {} {}: normals: {e}", case.name, case.variant.name()));
-            return;
-        }
-        let cloud_path = self.out_dir.join(format!("{stem}-cloud.ply"));
-        if let Err(e) = io::write(&cloud_path, &oriented) {
-            self.notes.push(format!("Peers on {}: {e}", case.name));
-            return;
-        }
-        drop(oriented);
-        let mut outcomes = run_peers(self.root, &self.out_dir, &methods, self.o.peer_runs, &cloud_path, stem);
+        // The normals vstree uses: the given ones, or its own estimate where the cloud has none
+        // (deterministic, the same parameters), written to a PLY file (in doubles for a cloud
+        // far from the origin) that every peer reads.
+        let oriented = self.out_dir.join(format!("{stem}-oriented.ply"));
+        let cloud_path = if needs_normals {
+            let normal_params = NormalParams { threads: self.o.threads, ..ReconstructParams::default().normals };
+            let estimated = io::read(cloud).map_err(|e| e.to_string()).and_then(|mut c| {
+                ensure_normals(&mut c, &normal_params, &mut Progress::none()).map_err(|e| e.to_string())?;
+                io::write(&oriented, &c).map_err(|e| e.to_string())
+            });
+            if let Err(e) = estimated {
+                self.notes.push(format!("Peers on {} {}: normals: {e}", case.name, case.variant.name()));
+                return;
+            }
+            oriented.as_path()
+        } else {
+            cloud
+        };
+        let mut outcomes = run_peers(self.root, &self.out_dir, &methods, self.o.peer_runs, cloud_path, stem);
         if let (Err(e), true) = (&outcomes, methods.len() > 1) {
             // One method may crash the script (a segmentation fault far from the origin): run
             // each on its own, so the others are measured and the crash is a failed row.
@@ -482,7 +520,7 @@ impl Bench<'_> {
                     &self.out_dir,
                     std::slice::from_ref(method),
                     self.o.peer_runs,
-                    &cloud_path,
+                    cloud_path,
                     stem,
                 ) {
                     Ok(o) => each.extend(o),
@@ -516,7 +554,9 @@ impl Bench<'_> {
             Err(e) => self.notes.push(format!("Peers on {} {}: {e}", case.name, case.variant.name())),
         }
         row.peers.sort_by_key(|p| CLOSED_PEERS.iter().chain(&OPEN_PEERS).position(|m| *m == p.method));
-        let _ = std::fs::remove_file(&cloud_path);
+        if needs_normals {
+            let _ = std::fs::remove_file(&oriented);
+        }
     }
 }
 

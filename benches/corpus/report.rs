@@ -1,8 +1,8 @@
 //! The Markdown report of the corpus bench: summary lines per method, the rows (vstree and the
-//! better screened Poisson of each depth), vstree's stages, and every peer's raw rows.
+//! better screened Poisson of each depth), vstree's stages and memory, and every peer's raw rows.
 
+use crate::child::VstreeRun;
 use crate::common::inputs::short_count;
-use crate::common::reconstruction::Stages;
 use crate::common::report::{percent, relative, relative_or_dash, secs, thousands, Run};
 use crate::common::stats::median;
 use crate::inputs::{Variant, TRUTH_SAMPLES};
@@ -20,8 +20,8 @@ pub struct Row {
     pub open: bool,
     pub truth_genus: Option<u32>,
     pub truth_components: usize,
-    /// Stage times, refinement levels and figures, or why it failed.
-    pub vstree: Result<(Stages, usize, Quality), String>,
+    /// What vstree's child measured and the output's figures, or why it failed.
+    pub vstree: Result<(VstreeRun, Quality), String>,
     pub peers: Vec<PeerRow>,
 }
 
@@ -102,8 +102,8 @@ impl Row {
     /// `None` when the method did not run on this row; `Some(None)` when it ran and failed.
     fn entry(&self, method: Method) -> Option<Option<Entry<'_>>> {
         match method {
-            Method::Vstree => Some(self.vstree.as_ref().ok().map(|(s, _, q)| Entry {
-                seconds: s.total,
+            Method::Vstree => Some(self.vstree.as_ref().ok().map(|(run, q)| Entry {
+                seconds: run.seconds.total,
                 quality: q,
                 method: "vstree",
             })),
@@ -285,9 +285,9 @@ impl Report {
         let _ = write!(
             md,
             "### Rows\n\n\
-             Time: the reconstruction call alone (cloud in memory; vstree's includes estimating normals where the \
-             cloud has none, the peers get those normals for free). Vertices: used by a triangle. Genus and \
-             components: the output's, then the truth's. Chamfer = mean of the two mean distances (from \
+             Time: the reconstruction call alone (cloud in memory; vstree's in a process of its own, and includes \
+             estimating normals where the cloud has none, the peers get those normals for free). Vertices: used by \
+             a triangle. Genus and components: the output's, then the truth's. Chamfer = mean of the two mean distances (from \
              200k points on the output's surface to the true mesh's triangles; from {} points on the true mesh \
              to the output's triangles), Hausdorff = the larger of the two maxima; both over the true mesh's \
              bounding-box diagonal. < 10°, < 20°: share of triangles with an angle under that. Valence 6: share \
@@ -344,29 +344,88 @@ impl Report {
     fn stages(&self, md: &mut String) {
         md.push_str(
             "### vstree stage by stage\n\n\
-             Seconds per stage from `ReconstructStats` (normals: kept or estimated; M0: the base mesh; trim: only \
-             on open inputs), the whole call, the time per input point, and the refinement levels done.\n\n\
-             | input | variant | points | normals | tree | M0 | refine | trim | total | µs/point | levels |\n\
-             |---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
+             T-nodes: the tree's T-layer (`stats.tree.t_nodes`); field evaluations: points where the base mesh's \
+             implicit function was evaluated (`stats.field_evaluations`). Seconds per stage from `ReconstructStats` \
+             (normals: kept or estimated; M0: the base mesh; trim: only on open inputs), the whole call, M0's share \
+             of it, the time per input point, and the refinement levels done. Memory, in bytes per input point: \
+             peak = the largest resident size (`VmHWM`) of the process that ran the call, which holds only the \
+             program and the cloud (read from PLY) besides; call = that peak less the resident size just before \
+             the call (what the call itself added). Speed: Open3D's Poisson depth 8 time over vstree's whole \
+             call on the same row.\n\n",
+        );
+        self.stage_summary(md);
+        md.push_str(
+            "| input | variant | points | T-nodes | field evaluations | normals | tree | M0 | refine | trim | total \
+             | M0 share | µs/point | peak B/point | call B/point | levels |\n\
+             |---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n",
         );
         for r in &self.rows {
-            let Ok((s, levels, _)) = &r.vstree else { continue };
+            let Ok((run, _)) = &r.vstree else { continue };
+            let (s, m) = (&run.seconds, &run.memory);
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {levels} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2} | {} | {} | {} |",
                 r.name,
                 r.variant.name(),
                 thousands(r.points),
+                thousands(run.t_nodes),
+                thousands(run.field_evaluations),
                 secs(s.normals),
                 secs(s.tree),
                 secs(s.base),
                 secs(s.refine),
                 secs(s.trim),
                 secs(s.total),
+                percent(s.base / s.total),
                 1e6 * s.total / r.points as f64,
+                thousands(m.total_per(r.points).round() as usize),
+                thousands(m.added_per(r.points).round() as usize),
+                run.levels,
+            );
+        }
+        let unreset = self.rows.iter().filter(|r| matches!(&r.vstree, Ok((run, _)) if !run.memory.reset)).count();
+        if unreset > 0 {
+            let _ = writeln!(
+                md,
+                "\nOn {unreset} rows the peak counter could not be reset after reading the cloud: their peak may be \
+                 the reading's."
             );
         }
         md.push('\n');
+    }
+
+    /// The stage table's summary: M0's share, the peak memory, and the speed against Open3D's
+    /// Poisson depth 8, each at the median and the worst row.
+    fn stage_summary(&self, md: &mut String) {
+        let mut share = Vec::new();
+        let mut bytes = Vec::new();
+        let mut speed = Vec::new();
+        for r in &self.rows {
+            let Ok((run, _)) = &r.vstree else { continue };
+            share.push((run.seconds.base / run.seconds.total, r.label()));
+            bytes.push((run.memory.total_per(r.points), r.label()));
+            if let Some(p) = r.peer("open3d-poisson8") {
+                speed.push((p.seconds / run.seconds.total, r.label()));
+            }
+        }
+        let mut parts = Vec::new();
+        if let Some((m, w, at)) = median_worst(&share, false) {
+            parts.push(format!("M0 share median {}, worst {} ({at})", percent(m), percent(w)));
+        }
+        if let Some((m, w, at)) = median_worst(&bytes, false) {
+            let b = |x: f64| thousands(x.round() as usize);
+            parts.push(format!("peak memory median {} B/point, worst {} B/point ({at})", b(m), b(w)));
+        }
+        match median_worst(&speed, true) {
+            Some((m, w, at)) => parts.push(format!(
+                "speed against Open3D Poisson depth 8 median {m:.2}×, worst {w:.2}× ({at}; {} rows)",
+                speed.len()
+            )),
+            None => parts.push("no Open3D Poisson depth 8 rows to compare the speed with".into()),
+        }
+        if !share.is_empty() {
+            let _ = writeln!(md, "**Summary** ({} rows): {}.\n", share.len(), parts.join("; "));
+        }
     }
 
     fn raw(&self, md: &mut String) {
