@@ -74,9 +74,14 @@ const SYNTHETIC: usize = 200_000;
 const QUICK_POINTS: usize = 20_000;
 
 /// vstree's base meshes by their `--base-mesh` name, with what the report's notes say of each.
-const BASE_MESHES: [(&str, BaseMesh, &str); 2] = [
+const BASE_MESHES: [(&str, BaseMesh, &str); 3] = [
     ("winding", BaseMesh::Winding, "the samples' winding number and distance, on a grid as fine as the deepest T-node"),
     ("paper", BaseMesh::Paper, "the paper's blended T-node planes near the samples, the winding number beyond"),
+    (
+        "adaptive",
+        BaseMesh::Adaptive,
+        "the winding number's side, dual-contoured over the tree's octree (T-nodes as cells)",
+    ),
 ];
 
 /// The base mesh of a `--base-mesh` name.
