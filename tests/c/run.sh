@@ -97,7 +97,16 @@ LD_LIBRARY_PATH="$PWD/target/release" "$build/example-local" "$tmp/out.ply" "$tm
 LD_LIBRARY_PATH="$PWD/target/release" ldd "$build/example-local" | grep "libvstree.so.$abi => $PWD/target/release/libvstree.so.$abi" >/dev/null
 
 echo "-- find_package(vstree) from CMake"
-cmake -S tests/c/cmake -B "$build/cmake" -DCMAKE_PREFIX_PATH="$prefix" >/dev/null
+cmake -S tests/c/cmake -B "$build/cmake" -DCMAKE_PREFIX_PATH="$prefix" -DVSTREE_WANTED="${version%.*}" >/dev/null
+# Before 1.0 a minor release may break the API, so the package refuses an application written
+# for the previous minor version.
+major=${version%%.*}
+minor=$(echo "$version" | cut -d. -f2)
+if [ "$major" = 0 ] && [ "$minor" -gt 0 ] && cmake -S tests/c/cmake -B "$build/cmake-previous" \
+    -DCMAKE_PREFIX_PATH="$prefix" -DVSTREE_WANTED="0.$((minor - 1))" >/dev/null 2>&1; then
+    echo "find_package(vstree 0.$((minor - 1))) accepted version $version" >&2
+    exit 1
+fi
 cmake --build "$build/cmake" >/dev/null
 "$build/cmake/vstree-wrapper"
 "$build/cmake/vstree-example" "$tmp/out.off" "$tmp/cmake-out.ply" 2>/dev/null
