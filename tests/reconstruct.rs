@@ -263,6 +263,27 @@ fn a_noisy_sphere_lands_on_the_true_sphere() {
     assert!(max < 0.045, "max distance to the true sphere {max}");
 }
 
+/// Gaussian noise of 0.5% of the diagonal on a torus (200k points, its tube a sixth of its
+/// size): the noise is measured and allowed for, so the base mesh makes no handle of it and
+/// the surface lands well inside the noise of the true torus.
+#[test]
+fn heavy_noise_is_measured_and_makes_no_handles() {
+    let (major, minor) = (1.0f32, 0.35f32);
+    let mut cloud = shapes::sample_surface(&shapes::torus(major, minor, 256, 96), 200_000, 8);
+    let diagonal = vstree::mesh::Aabb::of(&cloud.positions).unwrap().diagonal();
+    let sigma = 0.005 * diagonal;
+    shapes::add_noise(&mut cloud, sigma, 0.0, 9);
+    let (mesh, stats) = run(&cloud, &ReconstructParams::default());
+    let report = topology::analyze(&mesh);
+    assert!(report.is_watertight() && report.genus() == Some(1), "{report:?}");
+    let found = stats.noise / 0.005;
+    assert!((found - 1.0).abs() < 0.15, "noise found {:.4}% of the diagonal", 100.0 * stats.noise);
+    let off = |p: &Vec3| ((Vec3::new(p.x, p.y, 0.0).length() - major).hypot(p.z) - minor).abs();
+    let mean = mesh.positions.iter().map(off).sum::<f32>() / mesh.positions.len() as f32;
+    eprintln!("torus with noise {sigma:.4}: found {:.4}, mean distance {mean:.5}", stats.noise * f64::from(diagonal));
+    assert!(mean < 0.25 * sigma, "mean distance to the true torus {mean}, noise {sigma}");
+}
+
 #[test]
 fn a_cloud_without_normals_gets_them_estimated() {
     let mut cloud = shapes::sample_surface(&shapes::torus(1.0, 0.35, 96, 48), 40_000, 5);

@@ -708,6 +708,7 @@ fn print_reconstruct(
     if let Some(o) = &s.normals.orient {
         say!("orientation: {} components, {} flipped", o.components, o.flipped);
     }
+    say!("noise: {:.3}% of the diagonal (the tree and the fits look past it)", 100.0 * s.noise);
     print_tree(&s.tree)?;
     let genus = s.base_genus.map_or("not a closed manifold".to_string(), |g| format!("genus {g}"));
     let thickened = if s.thickened { " (thickened: the plain one had handles through thin parts)" } else { "" };

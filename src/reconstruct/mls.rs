@@ -17,9 +17,9 @@ use crate::tree::TreeSample;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-/// Samples per fit: a quadratic has six coefficients, so it needs a few times more to average
-/// noise; more blur detail smaller than their spread.
-const NEIGHBOURS: usize = 24;
+/// Samples per fit on a clean cloud: a quadratic has six coefficients, so it needs a few times
+/// more to average noise; more blur detail smaller than their spread.
+pub(crate) const NEIGHBOURS: usize = 24;
 /// Samples whose tangent planes vote for the side of a point next to them: a few, so that one
 /// noisy normal does not decide, and few enough to stay on one side of a thin part.
 const SIDE_NEIGHBOURS: usize = 8;
@@ -34,13 +34,21 @@ const SAME_SIDE: f32 = 0.0;
 pub(crate) struct SampleSurface<'a> {
     samples: &'a [TreeSample],
     index: KdTree,
+    /// Samples per fit.
+    neighbours: usize,
 }
 
 impl<'a> SampleSurface<'a> {
-    pub fn new(samples: &'a [TreeSample], threads: &Threads) -> crate::error::Result<SampleSurface<'a>> {
+    /// The surface of `samples`, each fit made over `neighbours` of them (at least
+    /// [`NEIGHBOURS`]; more average more noise away).
+    pub fn new(
+        samples: &'a [TreeSample],
+        neighbours: usize,
+        threads: &Threads,
+    ) -> crate::error::Result<SampleSurface<'a>> {
         let positions: Vec<Vec3> = samples.iter().map(|s| s.position).collect();
         let index = threads.run(|| KdTree::new(&positions))?;
-        Ok(SampleSurface { samples, index })
+        Ok(SampleSurface { samples, index, neighbours: neighbours.clamp(NEIGHBOURS, crate::spatial::MAX_K) })
     }
 
     /// The mean signed distance from `p` to the tangent planes of its [`SIDE_NEIGHBOURS`]
@@ -62,7 +70,7 @@ impl<'a> SampleSurface<'a> {
     pub fn project(&self, p: Vec3, n: Vec3) -> Option<(Vec3, Vec3)> {
         let mut q = p;
         let mut normal = n;
-        let mut neighbours = Vec::with_capacity(NEIGHBOURS);
+        let mut neighbours = Vec::with_capacity(self.neighbours);
         for _ in 0..PLANE_ITERATIONS {
             self.same_side(q, n, &mut neighbours);
             let (centroid, mean_normal) = plane(&neighbours)?;
@@ -82,7 +90,7 @@ impl<'a> SampleSurface<'a> {
     /// at the farthest one (Wendland's (1 - r²)²).
     fn same_side(&self, q: Vec3, n: Vec3, out: &mut Vec<(Vec3, Vec3, f64)>) {
         out.clear();
-        let found = self.index.knn(q, NEIGHBOURS);
+        let found = self.index.knn(q, self.neighbours);
         let reach2 = found.last().map_or(0.0, |f| f.distance_squared) * 1.1 + f32::MIN_POSITIVE;
         for f in found {
             let s = &self.samples[f.index as usize];
@@ -248,7 +256,7 @@ pub(crate) mod tests {
     #[test]
     fn a_point_off_a_sphere_lands_on_it_without_the_planes_sag() {
         let samples = sphere_samples(4000, 1.0);
-        let surface = SampleSurface::new(&samples, &Threads::new(1).unwrap()).unwrap();
+        let surface = SampleSurface::new(&samples, NEIGHBOURS, &Threads::new(1).unwrap()).unwrap();
         for dir in [Vec3::new(0.3, -0.5, 0.8), Vec3::X, Vec3::new(-0.2, 0.1, -0.9)] {
             let dir = dir.normalize();
             for r in [0.97, 1.0, 1.03] {
@@ -275,7 +283,7 @@ pub(crate) mod tests {
                 samples.push(TreeSample { position: Vec3::new(x, y, 0.01), normal: Vec3::Z, index: index + 1 });
             }
         }
-        let surface = SampleSurface::new(&samples, &Threads::new(1).unwrap()).unwrap();
+        let surface = SampleSurface::new(&samples, NEIGHBOURS, &Threads::new(1).unwrap()).unwrap();
         let (p, _) = surface.project(Vec3::new(0.013, 0.0, 0.008), Vec3::Z).unwrap();
         assert!((p.z - 0.01).abs() < 1e-5, "{p}");
         let (p, _) = surface.project(Vec3::new(0.013, 0.0, 0.002), -Vec3::Z).unwrap();
@@ -305,7 +313,7 @@ pub(crate) mod tests {
     fn unfold_onto_the_sphere(s: &mut Surface) -> f32 {
         let threads = Threads::new(1).unwrap();
         let samples = sphere_samples(20_000, 1.0);
-        let onto = SampleSurface::new(&samples, &threads).unwrap();
+        let onto = SampleSurface::new(&samples, NEIGHBOURS, &threads).unwrap();
         let border = vec![false; s.positions.len()];
         unfold(s, &border, &onto, 0.2, &threads);
         s.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max)

@@ -198,6 +198,9 @@ pub struct ReconstructStats {
     /// Points left out as isolated: far from the rest for their neighbours' spacing (see
     /// `outliers`).
     pub isolated_points: usize,
+    /// The samples' noise level over the bounding box's diagonal: the standard deviation of
+    /// their distance to a smooth surface, as local quadratic fits leave it (see `noise`).
+    pub noise: f64,
     pub tree: TreeStats,
     /// Cells across the polygonisation grid (a power of two).
     pub grid_cells: u32,

@@ -203,7 +203,7 @@ mod tests {
         };
         let samples = sphere_samples(20_000, 1.0);
         let threads = Threads::new(1).unwrap();
-        let onto = SampleSurface::new(&samples, &threads).unwrap();
+        let onto = SampleSurface::new(&samples, crate::reconstruct::mls::NEIGHBOURS, &threads).unwrap();
         let before = thin_share(&s, 20.0);
         improve(&mut s, &onto, 0.1, &threads);
         let after = thin_share(&s, 20.0);

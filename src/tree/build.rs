@@ -10,7 +10,7 @@
 
 use super::indicator::{frame, is_height_field, reach};
 use super::partition::partition;
-use super::{Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
+use super::{beyond_noise, Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
 use crate::error::{Error, Result};
 use crate::mesh::{check_positions, Aabb};
 use crate::progress::{Progress, Threads};
@@ -27,8 +27,27 @@ const STATS_CHUNK: usize = 1 << 15;
 /// A node index with the sums of its samples (computed while partitioning its parent).
 pub(super) type Pending = (usize, CellStats);
 
+/// The height-field test allows each sample this many noise levels off its plane: the largest
+/// of a few hundred Gaussian deviations is about 3-4 of them, so a cell of noisy samples on a
+/// smooth surface is as flat as its clean samples would be, once allowed this.
+pub const NOISE_HEIGHTS: f32 = 4.0;
+
 /// Builds the tree `params` describes over `samples`.
 pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progress: &mut Progress) -> Result<VsTree> {
+    build_allowing_noise(samples, params, 0.0, threads, progress)
+}
+
+/// [`build`], for samples that scatter about their surface with the standard deviation `noise`
+/// (absolute): the height-field test allows each sample [`NOISE_HEIGHTS`] times that off its
+/// cell's plane, so that the T-layer sits where the surface is a height field, not where the
+/// cells are too small to hold the noise.
+pub fn build_allowing_noise(
+    samples: &SampleSet,
+    params: &TreeParams,
+    noise: f32,
+    threads: &Threads,
+    progress: &mut Progress,
+) -> Result<VsTree> {
     params.check()?;
     check_samples(samples)?;
     progress.report(0.0, "building tree")?;
@@ -40,7 +59,7 @@ pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progre
     // rounding of the coordinates), in proportion to the input's own scale so that the tree
     // does not depend on units; never zero.
     let half = 0.5 * extent * (1.0 + 1e-4) + 1e-6 * (extent + center.abs().max_element()) + 1e-30;
-    let builder = Builder::new(params, center, diagonal);
+    let builder = Builder::new(params, center, diagonal, noise);
 
     let mut work: Vec<TreeSample> = threads.run(|| {
         (samples.positions.par_iter(), samples.normals.par_iter())
@@ -116,7 +135,7 @@ pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progre
     for (i, local_nodes, local_frames) in results {
         append_part(&mut nodes, &mut frames, i, local_nodes, local_frames, shared_len);
     }
-    Ok(VsTree { nodes, frames, samples: work, diagonal, params: *params })
+    Ok(VsTree { nodes, frames, samples: work, diagonal, params: *params, noise })
 }
 
 fn check_samples(samples: &SampleSet) -> Result<()> {
@@ -179,17 +198,20 @@ pub(super) struct Builder {
     /// The L2 bound in absolute (squared) units.
     abs_error: f64,
     min_half: f32,
+    /// The samples' noise level (absolute).
+    noise: f32,
 }
 
 impl Builder {
     /// The builder of a tree whose root is centred on `center`, over samples whose bounding
-    /// box has diagonal `diagonal`.
-    pub(super) fn new(params: &TreeParams, center: Vec3, diagonal: f32) -> Builder {
+    /// box has diagonal `diagonal` and scatter about their surface by `noise`.
+    pub(super) fn new(params: &TreeParams, center: Vec3, diagonal: f32, noise: f32) -> Builder {
         Builder {
             params: *params,
             origin: center.as_dvec3(),
             abs_error: params.error * f64::from(diagonal).powi(2),
             min_half: (0.5 * params.min_cell_size * f64::from(diagonal)) as f32,
+            noise,
         }
     }
 
@@ -229,7 +251,8 @@ impl Builder {
         let slice = part.slice(&node);
         let centroid = (stats.centroid() + self.origin).as_vec3();
         let reach = reach(centroid, node.center, node.half);
-        if is_height_field(slice, centroid, stats.mean_normal(), reach, self.params.d_a, self.params.d_d) {
+        let (d_a, d_d) = (self.params.d_a, self.params.d_d);
+        if is_height_field(slice, centroid, stats.mean_normal(), reach, d_a, d_d, NOISE_HEIGHTS * self.noise) {
             let f = frame(slice, stats, self.origin);
             let index = (part.shared_frames.len() + part.frames.len()) as u32;
             part.frames.push(f);
@@ -239,10 +262,15 @@ impl Builder {
         }
     }
 
-    /// The node's error ([`Metric::cell_error`]) in the units of [`Builder::threshold`].
+    /// The node's error ([`Metric::cell_error`], the L2 error beyond what the noise explains)
+    /// in the units of [`Builder::threshold`].
     pub(super) fn error(&self, part: &Part, node: &Node, stats: &CellStats) -> f64 {
         let frame = (node.kind == NodeKind::Surface).then(|| part.frame(node.frame));
-        self.params.metric.cell_error(node, frame, stats, self.origin)
+        let error = self.params.metric.cell_error(node, frame, stats, self.origin);
+        match self.params.metric {
+            Metric::L2 => beyond_noise(error, stats.count, self.noise),
+            Metric::L21 | Metric::Density => error,
+        }
     }
 
     /// The bound on [`Builder::error`] below which a node is a leaf.

@@ -45,7 +45,7 @@ impl Ord for Queued {
 /// `params.error` is left as it was: it no longer describes the leaves.
 pub fn fit(tree: &mut VsTree, leaves: usize, threads: &Threads) -> usize {
     let leaves = leaves.max(1);
-    let builder = Builder::new(&tree.params, tree.root().center, tree.diagonal);
+    let builder = Builder::new(&tree.params, tree.root().center, tree.diagonal, tree.noise);
     let mut stats = node_stats(tree, builder.origin, threads);
     let mut expanded = vec![false; tree.nodes.len()];
     let mut part = Part {

@@ -7,7 +7,8 @@ use glam::{DVec3, Vec2, Vec3};
 
 /// k(Sᵢ): true when the samples can be seen as a height field over the plane through their
 /// centroid `c` with normal n̄ (the normalised average normal):
-/// every nⱼ·n̄ > d_a (normal cone), and max |(pⱼ − c)·n̄| < d_d · max ‖pₖ − c‖ (displacement).
+/// every nⱼ·n̄ > d_a (normal cone), and max |(pⱼ − c)·n̄| < d_d · max ‖pₖ − c‖ + `allowance`
+/// (displacement; the allowance is for the samples' noise).
 /// Samples with a zero normal carry no orientation and are left out of the cone test.
 ///
 /// `reach` bounds every ‖pₖ − c‖ from above (the distance from c to the cell's farthest corner,
@@ -21,12 +22,13 @@ pub(super) fn is_height_field(
     reach: f32,
     d_a: f32,
     d_d: f32,
+    allowance: f32,
 ) -> bool {
     if mean_normal.length() < 1e-6 {
         return false; // normals cancel out: no plane to project on
     }
     let n = mean_normal.normalize().as_vec3();
-    let too_high = d_d * reach;
+    let too_high = d_d * reach + allowance;
     let mut max_height = 0.0f32;
     let mut max_radius_sq = 0.0f32;
     for s in samples {
@@ -39,7 +41,7 @@ pub(super) fn is_height_field(
         max_radius_sq = max_radius_sq.max(d.length_squared());
     }
     // All samples at one point: trivially flat.
-    max_radius_sq == 0.0 || max_height < d_d * max_radius_sq.sqrt()
+    max_radius_sq == 0.0 || max_height < d_d * max_radius_sq.sqrt() + allowance
 }
 
 /// An upper bound of the distance from `p` (inside the cube `center ± half`) to any point of
@@ -108,11 +110,19 @@ mod tests {
     fn flat_patch_is_a_height_field_and_a_fold_is_not() {
         let flat: Vec<_> = (0..25).map(|i| sample(Vec3::new((i % 5) as f32, (i / 5) as f32, 0.0), Vec3::Z)).collect();
         let st = stats_of(&flat);
-        assert!(is_height_field(&flat, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0 / 6.0));
+        assert!(is_height_field(&flat, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0 / 6.0, 0.0));
         let mut folded = flat.clone();
         folded.push(sample(Vec3::new(2.0, 2.0, 0.1), -Vec3::Z));
         let st = stats_of(&folded);
-        assert!(!is_height_field(&folded, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0 / 6.0));
+        assert!(!is_height_field(
+            &folded,
+            st.centroid().as_vec3(),
+            st.mean_normal(),
+            f32::INFINITY,
+            0.0,
+            1.0 / 6.0,
+            0.0
+        ));
     }
 
     #[test]
@@ -120,8 +130,8 @@ mod tests {
         let mut s: Vec<_> = (0..25).map(|i| sample(Vec3::new((i % 5) as f32, (i / 5) as f32, 0.0), Vec3::Z)).collect();
         s.push(sample(Vec3::new(2.0, 2.0, 1.5), Vec3::Z));
         let st = stats_of(&s);
-        assert!(!is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0 / 6.0));
-        assert!(is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0));
+        assert!(!is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0 / 6.0, 0.0));
+        assert!(is_height_field(&s, st.centroid().as_vec3(), st.mean_normal(), f32::INFINITY, 0.0, 1.0, 0.0));
     }
 
     #[test]
@@ -140,8 +150,8 @@ mod tests {
             let c = st.centroid().as_vec3();
             let r = reach(c, Vec3::splat(2.0), 2.0);
             for d_d in [0.0, 0.05, 1.0 / 6.0, 0.3, 1.0] {
-                let full = is_height_field(&s, c, st.mean_normal(), f32::INFINITY, 0.0, d_d);
-                assert_eq!(is_height_field(&s, c, st.mean_normal(), r, 0.0, d_d), full, "bump {bump}, d_d {d_d}");
+                let full = is_height_field(&s, c, st.mean_normal(), f32::INFINITY, 0.0, d_d, 0.0);
+                assert_eq!(is_height_field(&s, c, st.mean_normal(), r, 0.0, d_d, 0.0), full, "bump {bump}, d_d {d_d}");
             }
         }
     }

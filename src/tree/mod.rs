@@ -17,7 +17,7 @@ use crate::quadric::CellStats;
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
-pub use build::build;
+pub use build::{build, build_allowing_noise, NOISE_HEIGHTS};
 pub use fit::fit;
 
 /// Which hierarchy to build.
@@ -204,6 +204,21 @@ impl Metric {
     }
 }
 
+/// How many standard deviations of a noisy cell's L2 error [`beyond_noise`] allows above its
+/// mean: 3 leaves a flat cell of Gaussian noise a leaf in all but about one in a thousand cases.
+pub const NOISE_SPREADS: f64 = 3.0;
+
+/// The L2 error `quadric` of a cell of `count` samples beyond what their noise explains. Each
+/// sample scattered off a flat surface with standard deviation `noise` adds its squared height,
+/// so the sum is `noise`² times a chi-square with `count` degrees of freedom: mean `count`, spread
+/// √(2·`count`). What is beyond that mean plus [`NOISE_SPREADS`] spreads is the surface's own
+/// shape, which the L2 bound is about; the rest is noise, which the bound should not chase.
+pub fn beyond_noise(quadric: f64, count: u64, noise: f32) -> f64 {
+    let n = count as f64;
+    let explained = f64::from(noise).powi(2) * (n + NOISE_SPREADS * (2.0 * n).sqrt());
+    (quadric - explained).max(0.0)
+}
+
 /// `Node::frame` of a V-node.
 pub const NO_FRAME: u32 = u32::MAX;
 
@@ -275,6 +290,9 @@ pub struct VsTree {
     /// Diagonal of the samples' bounding box: the unit of relative thresholds.
     pub diagonal: f32,
     pub params: TreeParams,
+    /// The samples' noise level (absolute) that the height-field test allowed for; 0 unless the
+    /// tree was built by [`build_allowing_noise`].
+    pub noise: f32,
 }
 
 /// Figures that describe a tree.
@@ -321,6 +339,7 @@ impl VsTree {
         let error = self.params.metric.cell_error(node, frame, &stats, origin);
         match self.params.metric {
             Metric::L2 => {
+                let error = beyond_noise(error, stats.count, self.noise);
                 let scale = f64::from(self.diagonal).powi(2);
                 if scale > 0.0 {
                     error / scale
@@ -337,7 +356,7 @@ impl VsTree {
     /// when every leaf is within the bound or a single sample. For a tree as [`build`] made it
     /// (not reshaped by [`fit`]).
     pub fn limited_by(&self) -> Option<&'static str> {
-        let builder = build::Builder::new(&self.params, self.root().center, self.diagonal);
+        let builder = build::Builder::new(&self.params, self.root().center, self.diagonal, self.noise);
         self.leaves()
             .map(|i| &self.nodes[i])
             .filter(|node| node.count > 1 && self.node_error(node) > self.params.error)
@@ -436,5 +455,27 @@ mod tests {
             }
             assert!(leaves > 100 && inner > 10, "{metric:?}: {leaves} leaves, {inner} inner nodes checked");
         }
+    }
+
+    /// A flat unit square of 20k samples scattered off it by Gaussian noise of deviation 1% of
+    /// its side: with that noise allowed for, neither the height-field test nor the L2 bound
+    /// sees any shape, and the whole square is one T-node of a few leaves; without, the bound
+    /// chases the noise down to cells of a few samples each.
+    #[test]
+    fn the_noise_allowed_for_is_not_split_on() {
+        let sigma = 0.01;
+        let mut cloud = shapes::sample_surface(&shapes::square_grid(8), 20_000, 1);
+        shapes::add_noise(&mut cloud, sigma, 0.0, 2);
+        let samples = SampleSet::from_cloud(&cloud).unwrap();
+        let params = TreeParams { error: 1e-5, ..Default::default() };
+        let tree_allowing = |noise| {
+            build_allowing_noise(&samples, &params, noise, &Threads::new(1).unwrap(), &mut Progress::none()).unwrap()
+        };
+        let allowing = tree_allowing(sigma);
+        let stats = allowing.stats();
+        assert!(stats.t_nodes <= 4 && allowing.leaves().count() <= 4, "noise allowed for: {stats:?}");
+        let chasing = tree_allowing(0.0);
+        let leaves = chasing.leaves().count();
+        assert!(leaves > 2_000, "noise not allowed for: only {leaves} leaves");
     }
 }
