@@ -30,7 +30,7 @@ pub(super) type Pending = (usize, CellStats);
 /// The height-field test allows each sample this many noise levels off its plane: the largest
 /// of a few hundred Gaussian deviations is about 3-4 of them, so a cell of noisy samples on a
 /// smooth surface is as flat as its clean samples would be, once allowed this.
-pub const NOISE_HEIGHTS: f32 = 4.0;
+const NOISE_HEIGHTS: f32 = 4.0;
 
 /// Builds the tree `params` describes over `samples`.
 pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progress: &mut Progress) -> Result<VsTree> {
@@ -38,7 +38,7 @@ pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progre
 }
 
 /// [`build`], for samples that scatter about their surface with the standard deviation `noise`
-/// (absolute): the height-field test allows each sample [`NOISE_HEIGHTS`] times that off its
+/// (absolute): the height-field test allows each sample `NOISE_HEIGHTS` times that off its
 /// cell's plane, so that the T-layer sits where the surface is a height field, not where the
 /// cells are too small to hold the noise.
 pub fn build_allowing_noise(

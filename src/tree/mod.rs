@@ -17,7 +17,7 @@ use crate::quadric::CellStats;
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
-pub use build::{build, build_allowing_noise, NOISE_HEIGHTS};
+pub use build::{build, build_allowing_noise};
 pub use fit::fit;
 
 /// Which hierarchy to build.
@@ -206,14 +206,14 @@ impl Metric {
 
 /// How many standard deviations of a noisy cell's L2 error [`beyond_noise`] allows above its
 /// mean: 3 leaves a flat cell of Gaussian noise a leaf in all but about one in a thousand cases.
-pub const NOISE_SPREADS: f64 = 3.0;
+const NOISE_SPREADS: f64 = 3.0;
 
 /// The L2 error `quadric` of a cell of `count` samples beyond what their noise explains. Each
 /// sample scattered off a flat surface with standard deviation `noise` adds its squared height,
 /// so the sum is `noise`² times a chi-square with `count` degrees of freedom: mean `count`, spread
 /// √(2·`count`). What is beyond that mean plus [`NOISE_SPREADS`] spreads is the surface's own
 /// shape, which the L2 bound is about; the rest is noise, which the bound should not chase.
-pub fn beyond_noise(quadric: f64, count: u64, noise: f32) -> f64 {
+pub(super) fn beyond_noise(quadric: f64, count: u64, noise: f32) -> f64 {
     let n = count as f64;
     let explained = f64::from(noise).powi(2) * (n + NOISE_SPREADS * (2.0 * n).sqrt());
     (quadric - explained).max(0.0)
