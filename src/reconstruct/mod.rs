@@ -15,7 +15,8 @@
 //!    removes handles (see `THICKEN_CELLS`);
 //! 3. refine: split 1-to-4 on PN triangles and displace by the quadtrees ([`refine`]); every
 //!    vertex of M0 and of each level is then projected onto a local quadratic fit of its nearest
-//!    samples ([`mls`]; more of them the noisier the cloud, see `fit_neighbours`), which the quadtree's leaves alone leave off by the curvature; until
+//!    samples ([`mls`]; more of them the noisier the cloud, see `fit_neighbours`), which the
+//!    quadtree's leaves alone leave off by the curvature; until
 //!    the mesh is close enough to the samples or the quadtrees have no detail left. M0 is
 //!    remeshed and each level's new vertices relaxed ([`relax`]), and folds are unfolded onto
 //!    the samples' fit ([`mls::unfold`]);
@@ -232,11 +233,11 @@ pub fn reconstruct(
     stats.seconds_normals = start.elapsed().as_secs_f64();
 
     let t0 = Instant::now();
-    // Noise is allowed for in the height-field test, so the T-layer is where the surface is
-    // a height field at the noise's scale and the base mesh sees no handles in the noise.
+    // The tree allows for the noise, so the T-layer is where the surface is a height field at
+    // the noise's scale (the base mesh sees no handles in it) and no cell is split to chase it.
     let noise = noise::noise_level(&samples.positions, &samples.normals, &threads)?;
-    stats.noise = f64::from(noise) / f64::from(crate::mesh::Aabb::of(&samples.positions).map_or(1.0, |b| b.diagonal()));
     let tree = tree::build_allowing_noise(&samples, &params.tree, noise, &threads, &mut progress.stage(0.15, 0.35))?;
+    stats.noise = if tree.diagonal > 0.0 { f64::from(noise / tree.diagonal) } else { 0.0 };
     stats.tree = tree.stats();
     if stats.tree.t_nodes == 0 {
         return Err(why_no_t_node(&tree, &params.tree));

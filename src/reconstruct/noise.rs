@@ -1,6 +1,7 @@
 //! The cloud's noise level: how far its samples scatter off a smooth surface, estimated from
-//! the residual of local quadratic fits. The tree's height-field test allows for it, so that
-//! noise does not look like detail (see [`crate::tree::build_allowing_noise`]).
+//! the residual of local quadratic fits. The tree allows for it in its height-field test and
+//! its L2 error, so that noise does not look like detail (see
+//! [`crate::tree::build_allowing_noise`]), and the fits of the samples' surface average it.
 
 use super::leaf_fit::solve;
 use crate::error::Result;
@@ -54,7 +55,6 @@ pub(super) fn noise_level(points: &[Vec3], normals: &[Vec3], threads: &Threads) 
     let facing: Vec<Vec3> = normals.iter().step_by(step).copied().collect();
     let near = threads.run(|| KdTree::new(&subsample))?;
     let probe_step = spread_step(subsample.len(), NOISE_PROBES);
-    let probes = (0..subsample.len()).step_by(probe_step).count();
     let found: Vec<(Option<f64>, f32)> = threads.run(|| {
         (0..subsample.len())
             .into_par_iter()
@@ -63,7 +63,7 @@ pub(super) fn noise_level(points: &[Vec3], normals: &[Vec3], threads: &Threads) 
             .collect()
     });
     let mut levels: Vec<f64> = found.iter().filter_map(|f| f.0).collect();
-    if levels.is_empty() || (levels.len() as f64) < NOISE_SHOWN * probes as f64 {
+    if levels.is_empty() || (levels.len() as f64) < NOISE_SHOWN * found.len() as f64 {
         return Ok(0.0);
     }
     levels.sort_by(f64::total_cmp);

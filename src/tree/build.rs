@@ -10,7 +10,7 @@
 
 use super::indicator::{frame, is_height_field, reach};
 use super::partition::partition;
-use super::{beyond_noise, Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
+use super::{Frame, Metric, Node, NodeKind, TreeKind, TreeParams, TreeSample, VsTree, NO_FRAME};
 use crate::error::{Error, Result};
 use crate::mesh::{check_positions, Aabb};
 use crate::progress::{Progress, Threads};
@@ -40,7 +40,8 @@ pub fn build(samples: &SampleSet, params: &TreeParams, threads: &Threads, progre
 /// [`build`], for samples that scatter about their surface with the standard deviation `noise`
 /// (absolute): the height-field test allows each sample `NOISE_HEIGHTS` times that off its
 /// cell's plane, so that the T-layer sits where the surface is a height field, not where the
-/// cells are too small to hold the noise.
+/// cells are too small to hold the noise; and the L2 error counts only what the noise does not
+/// explain, so cells are not split to chase it.
 pub fn build_allowing_noise(
     samples: &SampleSet,
     params: &TreeParams,
@@ -262,15 +263,11 @@ impl Builder {
         }
     }
 
-    /// The node's error ([`Metric::cell_error`], the L2 error beyond what the noise explains)
-    /// in the units of [`Builder::threshold`].
+    /// The node's error ([`Metric::cell_error`], allowing for the noise) in the units of
+    /// [`Builder::threshold`].
     pub(super) fn error(&self, part: &Part, node: &Node, stats: &CellStats) -> f64 {
         let frame = (node.kind == NodeKind::Surface).then(|| part.frame(node.frame));
-        let error = self.params.metric.cell_error(node, frame, stats, self.origin);
-        match self.params.metric {
-            Metric::L2 => beyond_noise(error, stats.count, self.noise),
-            Metric::L21 | Metric::Density => error,
-        }
+        self.params.metric.cell_error(node, frame, stats, self.origin, self.noise)
     }
 
     /// The bound on [`Builder::error`] below which a node is a leaf.

@@ -189,14 +189,15 @@ impl Metric {
     }
 
     /// The error of a cell under this metric, as the split test measures it before comparing:
-    /// L2, the quadric at the cell's [`representative`] (absolute, squared units); L2,1, the
+    /// L2, the quadric at the cell's [`representative`] beyond what samples scattered by
+    /// `noise` (absolute; see [`beyond_noise`]) explain (absolute, squared units); L2,1, the
     /// normal deviation; density, the sample count. `stats` sums the cell's samples relative to
     /// `origin`; `frame` is the frame of an S-node's T-node.
-    pub fn cell_error(self, node: &Node, frame: Option<&Frame>, stats: &CellStats, origin: DVec3) -> f64 {
+    pub fn cell_error(self, node: &Node, frame: Option<&Frame>, stats: &CellStats, origin: DVec3, noise: f32) -> f64 {
         match self {
             Metric::L2 => {
                 let x = representative(node, frame, stats, origin);
-                stats.quadric_at(x - origin)
+                beyond_noise(stats.quadric_at(x - origin), stats.count, noise)
             }
             Metric::L21 => stats.normal_deviation(),
             Metric::Density => stats.count as f64,
@@ -213,7 +214,7 @@ const NOISE_SPREADS: f64 = 3.0;
 /// so the sum is `noise`² times a chi-square with `count` degrees of freedom: mean `count`, spread
 /// √(2·`count`). What is beyond that mean plus [`NOISE_SPREADS`] spreads is the surface's own
 /// shape, which the L2 bound is about; the rest is noise, which the bound should not chase.
-pub(super) fn beyond_noise(quadric: f64, count: u64, noise: f32) -> f64 {
+fn beyond_noise(quadric: f64, count: u64, noise: f32) -> f64 {
     let n = count as f64;
     let explained = f64::from(noise).powi(2) * (n + NOISE_SPREADS * (2.0 * n).sqrt());
     (quadric - explained).max(0.0)
@@ -290,8 +291,8 @@ pub struct VsTree {
     /// Diagonal of the samples' bounding box: the unit of relative thresholds.
     pub diagonal: f32,
     pub params: TreeParams,
-    /// The samples' noise level (absolute) that the height-field test allowed for; 0 unless the
-    /// tree was built by [`build_allowing_noise`].
+    /// The samples' noise level (absolute) that the height-field test and the L2 error allowed
+    /// for; 0 unless the tree was built by [`build_allowing_noise`].
     pub noise: f32,
 }
 
@@ -336,10 +337,9 @@ impl VsTree {
         let origin = self.root().center.as_dvec3();
         let stats = build::sum(self.samples_of(node), origin);
         let frame = (node.kind == NodeKind::Surface).then(|| &self.frames[node.frame as usize]);
-        let error = self.params.metric.cell_error(node, frame, &stats, origin);
+        let error = self.params.metric.cell_error(node, frame, &stats, origin, self.noise);
         match self.params.metric {
             Metric::L2 => {
-                let error = beyond_noise(error, stats.count, self.noise);
                 let scale = f64::from(self.diagonal).powi(2);
                 if scale > 0.0 {
                     error / scale
