@@ -1,264 +1,247 @@
-//! The coarse base mesh M0 (paper §5.2): the fine polygonisation of the implicit function is
-//! clustered at the T-layer, one vertex per T-node.
-//!
-//! Plain vertex clustering can tear a mesh or fuse sheets (it keeps neither manifoldness nor
-//! genus), so the clustering is done by edge collapses restricted to each T-node's vertices,
-//! each allowed only under the link condition (Dey et al. 1999): the neighbours common to both
-//! ends must be exactly the two opposite corners of the edge. Such a collapse never changes the
-//! topology of a closed 2-manifold, so M0 is watertight with the polygonisation's genus. Where
-//! the link condition blocks the last collapses of a cluster (a cluster wrapped around a
-//! handle), the cluster keeps a few vertices: correct topology comes first.
+//! Stage 2: the base mesh M0, one vertex per T-node. The implicit function ([`field`]) is
+//! polygonised, over the tree's octree ([`BaseMesh::Adaptive`], [`dual_contour`]) or on a
+//! uniform grid ([`on_grid`]); faces no sample supports tell an open scan ([`support`]), whose
+//! unsupported part is dropped; the rest is clustered at the T-layer ([`cluster`]).
 
-use super::adjacency::Rows;
-use crate::collapse::Collapser;
+use super::lookup::Lookup;
+use super::prepare::keep_unmarked;
+use super::{adjacency, cluster, dual_contour, field, on_grid, refine, support};
+use super::{BaseMesh, Closure, ReconstructParams, ReconstructStats};
+use crate::error::{Error, Result};
 use crate::mesh::Mesh;
+use crate::progress::{Progress, Threads};
+use crate::topology;
 use crate::tree::{NodeKind, VsTree};
-use glam::Vec3;
 use rayon::prelude::*;
-use std::collections::VecDeque;
 
-/// No T-node.
-pub(crate) const UNLABELLED: u32 = u32::MAX;
+/// On an open M0, one vertex stands for a stretch of border at most this many typical T-node
+/// sides long (inside, one vertex stands for a T-node): a vertex per T-node along the border
+/// too cuts its bends short by as much as the T-node is large, and a flat region's T-node can
+/// span half the model. Half a side gave fans of slivers at the border (29% of the angles
+/// under 10 degrees on the fandisk view, against 20%), no limit a Chamfer 1.7x larger there.
+const BORDER_RUN: f32 = 1.0;
 
-/// The T-node whose cube contains `p`, if the octree's descent reaches one.
-pub(crate) fn t_node_at(tree: &VsTree, p: Vec3) -> Option<u32> {
-    let node = tree.locate(p)?;
-    let mut i = node;
-    // `locate` returns the deepest node: climb from an S-node back to its T-node.
-    while tree.nodes[i].kind == NodeKind::Surface {
-        i = tree.nodes[i].parent as usize;
-    }
-    (tree.nodes[i].kind == NodeKind::Transition).then_some(i as u32)
+/// M0, with what the later stages measure against.
+pub(super) struct Base {
+    pub surface: refine::Surface,
+    /// The output is open: asked for, or an open scan found.
+    pub open: bool,
+    /// What distances from the samples count in: the polygonisation grid's cell, or the
+    /// sample spacing where the samples are sparser than the grid.
+    pub unit: f32,
+    /// The polygonisation grid's cell (what `trim` counts in).
+    pub grid_cell: f32,
 }
 
-/// A T-node for every vertex: the one whose cube holds it, or else (the vertex lies in an empty
-/// cell) the label of the nearest labelled vertex along the mesh's edges.
-pub(crate) fn label_vertices(tree: &VsTree, mesh: &Mesh, neighbours: &Rows) -> Vec<u32> {
-    let labels: Vec<u32> = mesh.positions.par_iter().map(|&p| t_node_at(tree, p).unwrap_or(UNLABELLED)).collect();
-    spread_labels(labels, neighbours)
+/// The base mesh of the samples' tree.
+pub(super) fn build(
+    near: &Lookup,
+    params: &ReconstructParams,
+    threads: &Threads,
+    stats: &mut ReconstructStats,
+    progress: &mut Progress,
+) -> Result<Base> {
+    let tree = near.tree;
+    let grid = on_grid::grid(tree, params.max_grid_depth, near.spacing);
+    stats.grid_cells = grid.dims[0] - 5;
+    let unit = grid.cell.max(near.spacing);
+    let field = field::Field::new(tree, near, params.base_mesh, unit, grid.cell);
+    let polygonisation = Polygonisation {
+        tree,
+        near,
+        field: &field,
+        kind: params.base_mesh,
+        grid: &grid,
+        unit,
+        sag: plane_sags(tree, threads),
+        sample_normals: tree.samples.iter().map(|s| s.normal).collect(),
+        smallest_hole: smallest_hole(near),
+        why_no_surface: too_sparse_or_unoriented(tree, stats),
+        threads,
+    };
+    // Open asked for; `Auto` first polygonises as for a closed output and, if that finds an
+    // open scan, again as for an open one.
+    let asked_open = params.closure == Closure::Open || params.trim > 0.0;
+    let mut part = polygonisation.run(asked_open)?;
+    stats.unsupported_share = part.share;
+    let open = asked_open || support::is_open(params.closure, part.share);
+    if open && !asked_open {
+        part = polygonisation.run(true)?;
+    }
+    drop(polygonisation);
+    progress.report(0.4, "base mesh")?;
+    let Polygonised { mut fine, thickened, on_grid, neighbours, labels, unsupported, .. } = part;
+    stats.thickened = thickened;
+    stats.on_grid = on_grid;
+    stats.fine_triangles = fine.triangles.len();
+    stats.field_evaluations = field.evaluations();
+    let neighbours = if open {
+        // An open M0 is made of the supported part only: the closing sheet never joins a
+        // T-node's cluster.
+        keep_unmarked(&mut fine.triangles, &unsupported);
+        // Parts left smaller than the smallest hole are shreds of the closing sheet's edge.
+        drop_small_parts(&mut fine, smallest_hole(near));
+        adjacency::Rows::neighbours(&fine.triangles, fine.positions.len())
+    } else {
+        neighbours
+    };
+    let border_run = BORDER_RUN * 2.0 * near.typical_t_half;
+    let mut base = cluster::cluster_at_t_layer(&fine, &labels, &neighbours, grid.cell, border_run);
+    // Closed parts of M0 smaller than the smallest hole are shells that clustering flattened
+    // (a few T-nodes on a bubble of the implicit function): nothing a T-node can stand for.
+    // (An open M0's parts were sorted out on the fine mesh, where a part is not cut short.)
+    if !open && drop_small_parts(&mut base.mesh, smallest_hole(near)) {
+        base.drop_unused_vertices();
+    }
+    drop((fine, labels, neighbours));
+    if base.mesh.triangles.is_empty() {
+        return Err(Error::input(format!(
+            "the base mesh is empty: every part of the polygonised surface was smaller than the tree's \
+             T-layer can stand for ({})",
+            too_sparse_or_unoriented(tree, stats)
+        )));
+    }
+    stats.base_vertices = base.mesh.positions.len();
+    stats.base_triangles = base.mesh.triangles.len();
+    let report = topology::analyze(&base.mesh);
+    (stats.base_genus, stats.base_boundary_edges) = (report.genus(), report.boundary_edges);
+    let surface = refine::Surface {
+        normals: base.labels.iter().map(|&t| tree.frames[tree.nodes[t as usize].frame as usize].normal).collect(),
+        positions: base.mesh.positions,
+        labels: base.labels,
+        triangles: base.mesh.triangles,
+    };
+    Ok(Base { surface, open, unit, grid_cell: grid.cell })
 }
 
-/// Gives every vertex without a T-node ([`UNLABELLED`]) the label of the nearest labelled vertex
-/// along the mesh's edges.
-pub(crate) fn spread_labels(mut labels: Vec<u32>, neighbours: &Rows) -> Vec<u32> {
-    let mut queue: VecDeque<u32> = (0..labels.len() as u32).filter(|&v| labels[v as usize] != UNLABELLED).collect();
-    while let Some(v) = queue.pop_front() {
-        for &w in neighbours.of(v) {
-            if labels[w as usize] == UNLABELLED {
-                labels[w as usize] = labels[v as usize];
-                queue.push_back(w);
-            }
-        }
-    }
-    labels
+/// Parts and holes smaller than this area are below what the T-layer stands for: a square of
+/// the typical T-node's side.
+fn smallest_hole(near: &Lookup) -> f64 {
+    f64::from(2.0 * near.typical_t_half).powi(2)
 }
 
-/// A closed surface needs at least this many vertices: a component that spans fewer T-nodes
-/// cannot be represented at the T-layer (it is a bubble of the implicit function).
-const MIN_T_NODES_PER_COMPONENT: usize = 4;
-
-/// Marks the vertices of components that span fewer than [`MIN_T_NODES_PER_COMPONENT`]
-/// T-nodes, or that fit in a box of two grid cells (`cell`) a side. The latter is the
-/// polygoniser's smallest closed shell: one grid point whose sign differs from all its
-/// neighbours', wrapped in the 14 vertices of its star. It is below the grid's resolution,
-/// so it is not a part of the surface that the grid resolves but a bubble of the implicit
-/// function, such as the winding number leaves inside the tube of a sparsely sampled torus.
-fn stray_components(mesh: &Mesh, labels: &[u32], neighbours: &Rows, cell: f32) -> Vec<bool> {
-    let mut component = vec![u32::MAX; mesh.positions.len()];
-    let mut dropped = vec![false; mesh.positions.len()];
-    for start in 0..mesh.positions.len() {
-        if component[start] != u32::MAX || neighbours.of(start as u32).is_empty() {
-            continue;
-        }
-        let mut members = vec![start as u32];
-        component[start] = start as u32;
-        let mut k = 0;
-        while k < members.len() {
-            for &w in neighbours.of(members[k]) {
-                if component[w as usize] == u32::MAX {
-                    component[w as usize] = start as u32;
-                    members.push(w);
-                }
-            }
-            k += 1;
-        }
-        let mut t_nodes: Vec<u32> = members.iter().map(|&v| labels[v as usize]).collect();
-        t_nodes.sort_unstable();
-        t_nodes.dedup();
-        let (low, high) = members
-            .iter()
-            .map(|&v| mesh.positions[v as usize])
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
-        let sub_resolution = (high - low).max_element() <= 2.0 * cell;
-        if t_nodes.len() < MIN_T_NODES_PER_COMPONENT || sub_resolution {
-            for &v in &members {
-                dropped[v as usize] = true;
-            }
-        }
-    }
-    dropped
+/// What a cloud that gives no surface most likely is.
+fn too_sparse_or_unoriented(tree: &VsTree, stats: &ReconstructStats) -> String {
+    format!(
+        "{} points{}: too few or too scattered to sample a surface, or normals that do not face one way",
+        tree.samples.len(),
+        if stats.normals.estimated > 0 { ", normals estimated" } else { ", normals given" }
+    )
 }
 
-/// M0 with, per vertex, its T-node and how many fine vertices it stands for.
-pub(crate) struct BaseMesh {
-    pub mesh: Mesh,
-    pub labels: Vec<u32>,
+/// What polygonising the implicit function needs.
+struct Polygonisation<'a> {
+    tree: &'a VsTree,
+    near: &'a Lookup<'a>,
+    field: &'a field::Field<'a>,
+    kind: BaseMesh,
+    grid: &'a crate::polygonise::Grid,
+    unit: f32,
+    /// Per node, its plane's sag (see [`plane_sags`]).
+    sag: Vec<f32>,
+    sample_normals: Vec<glam::Vec3>,
+    smallest_hole: f64,
+    /// What a cloud that gives no surface most likely is.
+    why_no_surface: String,
+    threads: &'a Threads,
 }
 
-impl BaseMesh {
-    /// Removes the vertices no triangle uses, with their labels.
-    pub fn drop_unused_vertices(&mut self) {
-        let kept = super::renumber_used_vertices(&mut self.mesh.triangles, self.mesh.positions.len());
-        self.mesh.positions = kept.iter().map(|&v| self.mesh.positions[v]).collect();
-        self.labels = kept.iter().map(|&v| self.labels[v]).collect();
-    }
+/// The implicit function's zero set, polygonised, and what the base mesh needs of it.
+struct Polygonised {
+    fine: Mesh,
+    /// Thickened: see `on_grid::THICKEN_CELLS`.
+    thickened: bool,
+    /// Made on the uniform grid rather than over the tree's octree.
+    on_grid: bool,
+    neighbours: adjacency::Rows,
+    /// The T-node each vertex is clustered into.
+    labels: Vec<u32>,
+    /// Faces no sample supports, and their share of the area.
+    unsupported: Vec<bool>,
+    share: f64,
 }
 
-/// Collapses every edge whose ends share a label, while the link condition allows, and places
-/// each remaining vertex at the mean of the fine vertices it absorbed. Stray components
-/// (bubbles of the implicit function, see [`stray_components`]) are dropped.
-/// `neighbours` are the fine mesh's ([`Rows::neighbours`]). On an open mesh, one vertex of
-/// M0 stands for a stretch of border at most `border_run` long (see
-/// [`Collapser::limit_border_runs`]).
-pub(crate) fn cluster_at_t_layer(
-    fine: &Mesh,
-    labels: &[u32],
-    neighbours: &Rows,
-    cell: f32,
-    border_run: f32,
-) -> BaseMesh {
-    let mut c = Collapser::new(fine);
-    c.limit_border_runs(border_run);
-    let dropped = stray_components(fine, labels, neighbours, cell);
-    for (t, tri) in fine.triangles.iter().enumerate() {
-        if tri.iter().any(|&v| labels[v as usize] == UNLABELLED || dropped[v as usize]) {
-            c.remove_face_and_corners(t);
-        }
-    }
-    // Vertices of faces taken out before (an open M0's unsupported part).
-    for v in 0..fine.positions.len() {
-        if neighbours.of(v as u32).is_empty() {
-            c.remove_vertex(v);
-        }
-    }
-    c.collapse_within(labels);
-    let (mesh, labels) = c.finish(labels);
-    BaseMesh { mesh, labels }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::topology::analyze;
-
-    /// Eight labels: the octant of each vertex.
-    fn octant_labels(mesh: &Mesh) -> Vec<u32> {
-        mesh.positions
-            .iter()
-            .map(|p| (p.x > 0.0) as u32 | ((p.y > 0.0) as u32) << 1 | ((p.z > 0.0) as u32) << 2)
-            .collect()
-    }
-
-    #[test]
-    fn collapsing_keeps_the_genus() {
-        for (mesh, genus) in [
-            (crate::eval::shapes::icosphere(1.0, 3), 0),
-            (crate::eval::shapes::torus(1.0, 0.4, 48, 24), 1),
-            (crate::eval::shapes::double_torus(), 2),
-        ] {
-            // Eight clusters, the octants: collapse as far as topology allows.
-            let base = cluster_at_t_layer(
-                &mesh,
-                &octant_labels(&mesh),
-                &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
-                0.0,
-                f32::INFINITY,
-            );
-            let r = analyze(&base.mesh);
-            assert!(r.is_watertight(), "{r:?}");
-            assert_eq!(r.genus(), Some(genus));
-            assert!(base.mesh.positions.len() < 40, "{} vertices left", base.mesh.positions.len());
-        }
-    }
-
-    #[test]
-    fn an_open_mesh_collapses_along_its_border() {
-        // The upper half of a sphere in four clusters (the quadrants around z): a few vertices
-        // each, and the border stays one manifold loop.
-        let sphere = crate::eval::shapes::icosphere(1.0, 4);
-        let upper = sphere
-            .triangles
-            .iter()
-            .copied()
-            .filter(|t| t.iter().all(|&v| sphere.positions[v as usize].z > -1e-6))
-            .collect();
-        let mesh = Mesh::new(sphere.positions.clone(), None, upper);
-        let quadrants: Vec<u32> =
-            mesh.positions.iter().map(|p| (p.x > 0.0) as u32 | ((p.y > 0.0) as u32) << 1).collect();
-        let base = cluster_at_t_layer(
-            &mesh,
-            &quadrants,
-            &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
-            0.0,
-            f32::INFINITY,
-        );
-        let r = analyze(&base.mesh);
-        assert_eq!(r.non_manifold_edges, 0, "{r:?}");
-        assert!(r.boundary_edges >= 3, "{r:?}");
-        assert!(base.mesh.positions.len() <= 8, "{} vertices left", base.mesh.positions.len());
-    }
-
-    #[test]
-    fn a_large_open_cluster_keeps_its_border_within_the_run_length() {
-        // A flat 20 x 20 square in four clusters, vertical strips: unbounded, each outer
-        // strip's border (a side and two bits of the others) shrinks to one vertex at its
-        // mean, cutting the square's corners off; with runs of at most 0.3, every corner
-        // stays within 0.3 of an M0 vertex.
-        let mesh = crate::eval::shapes::square_grid(20);
-        let labels: Vec<u32> = mesh.positions.iter().map(|p| ((4.0 * p.x) as u32).min(3)).collect();
-        let rows = Rows::neighbours(&mesh.triangles, mesh.positions.len());
-        let corner_gap = |base: &BaseMesh| {
-            [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)]
-                .iter()
-                .map(|c| base.mesh.positions.iter().map(|p| p.distance(*c)).fold(f32::INFINITY, f32::min))
-                .fold(0.0f32, f32::max)
+impl Polygonisation<'_> {
+    /// The zero set for a closed or an `open` output.
+    fn run(&self, open: bool) -> Result<Polygonised> {
+        let (tree, threads) = (self.tree, self.threads);
+        // Where the adaptive polygonisation cannot make a 2-manifold even with its finest
+        // leaves (sheets closer than the samples resolve), the grid's is used.
+        let contour = match self.kind {
+            BaseMesh::Adaptive => dual_contour::contour(tree, &|p| self.field.at(p, open), self.unit, threads),
+            _ => None,
         };
-        let bounded = cluster_at_t_layer(&mesh, &labels, &rows, 0.0, 0.3);
-        let unbounded = cluster_at_t_layer(&mesh, &labels, &rows, 0.0, f32::INFINITY);
-        assert!(corner_gap(&bounded) < 0.3, "{}", corner_gap(&bounded));
-        assert!(corner_gap(&unbounded) > 0.3, "{}", corner_gap(&unbounded));
-        let r = analyze(&bounded.mesh);
-        assert_eq!(r.non_manifold_edges, 0, "{r:?}");
-        assert!(bounded.mesh.positions.len() < 30, "{} vertices", bounded.mesh.positions.len());
+        let on_grid = contour.is_none();
+        let (fine, labels, thickened) = match contour {
+            Some(c) => (Mesh::new(c.positions, None, c.triangles), Some(c.labels), false),
+            None => {
+                let (fine, thickened) = on_grid::polygonise(self.grid, tree, self.field, open, threads)?;
+                (fine, None, thickened)
+            }
+        };
+        if fine.triangles.is_empty() {
+            return Err(Error::input(match self.kind {
+                BaseMesh::Winding | BaseMesh::Adaptive => format!(
+                    "the points enclose no volume: their winding number stays below one half everywhere \
+                     near them ({})",
+                    self.why_no_surface
+                ),
+                BaseMesh::Paper => format!(
+                    "the blended T-node planes have no zero crossing near the samples ({})",
+                    self.why_no_surface
+                ),
+            }));
+        }
+        let neighbours = adjacency::Rows::neighbours(&fine.triangles, fine.positions.len());
+        let labels = match labels {
+            Some(labels) => cluster::spread_labels(labels, &neighbours),
+            None => threads.run(|| cluster::label_vertices(tree, &fine, &neighbours)),
+        };
+        let reach = support::SUPPORT_REACH * self.unit;
+        // A face of the adaptive polygonisation spans whole T-nodes, so its centre is as far
+        // from the surface as a chord of that length sags: up to half its longest edge.
+        let chord = |f: usize| {
+            let [a, b, c] = fine.triangles[f].map(|v| fine.positions[v as usize]);
+            0.5 * a.distance(b).max(b.distance(c)).max(c.distance(a))
+        };
+        let face_reach = |f: usize| {
+            let sag = self.sag.get(labels[fine.triangles[f][0] as usize] as usize).copied().unwrap_or(0.0);
+            reach + sag + if self.kind == BaseMesh::Adaptive { chord(f) } else { 0.0 }
+        };
+        let support = support::supported_faces(&fine, self.near.index(), &self.sample_normals, face_reach, threads);
+        // Faces that no sample supports: far from all, or near only samples facing the other
+        // way (the closing sheet right behind an open scan).
+        let unsupported: Vec<bool> = support.iter().map(|&s| s != support::Support::Supported).collect();
+        let unsupported = support::without_small_regions(&fine, &unsupported, self.smallest_hole);
+        let share = support::unsupported_share(&fine, &unsupported);
+        Ok(Polygonised { fine, thickened, on_grid, neighbours, labels, unsupported, share })
     }
+}
 
-    #[test]
-    fn components_spanning_fewer_than_four_t_nodes_are_dropped() {
-        let mesh = crate::eval::shapes::icosphere(1.0, 2);
-        let base = cluster_at_t_layer(
-            &mesh,
-            &vec![0; mesh.positions.len()],
-            &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
-            0.0,
-            f32::INFINITY,
-        );
-        assert!(base.mesh.positions.is_empty() && base.mesh.triangles.is_empty());
+/// Removes the connected parts of `mesh` whose area is below `smallest`; whether any went.
+fn drop_small_parts(mesh: &mut Mesh, smallest: f64) -> bool {
+    let (part, parts) = support::regions(mesh, &vec![true; mesh.triangles.len()]);
+    if parts.iter().all(|p| p.area >= smallest) {
+        return false;
     }
+    let mut p = part.iter();
+    mesh.triangles.retain(|_| p.next().is_some_and(|&r| parts[r as usize].area >= smallest));
+    true
+}
 
-    #[test]
-    fn labels_partition_a_sphere_into_clusters() {
-        let mesh = crate::eval::shapes::icosphere(1.0, 4);
-        // Eight clusters: the octants.
-        let base = cluster_at_t_layer(
-            &mesh,
-            &octant_labels(&mesh),
-            &Rows::neighbours(&mesh.triangles, mesh.positions.len()),
-            0.0,
-            f32::INFINITY,
-        );
-        let r = analyze(&base.mesh);
-        assert!(r.is_watertight() && r.genus() == Some(0));
-        assert_eq!(base.mesh.positions.len(), 8, "one vertex per octant");
-        assert_eq!(base.mesh.triangles.len(), 12);
-    }
+/// Per node, for T-nodes: the largest distance from one of its samples to its plane (0 for
+/// other nodes, and for a label no T-node has).
+fn plane_sags(tree: &VsTree, threads: &Threads) -> Vec<f32> {
+    threads.run(|| {
+        tree.nodes
+            .par_iter()
+            .map(|node| {
+                if node.kind != NodeKind::Transition {
+                    return 0.0;
+                }
+                let frame = &tree.frames[node.frame as usize];
+                tree.samples_of(node).iter().map(|s| frame.height(s.position).abs()).fold(0.0, f32::max)
+            })
+            .collect()
+    })
 }

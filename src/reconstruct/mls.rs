@@ -51,6 +51,17 @@ impl<'a> SampleSurface<'a> {
         Ok(SampleSurface { samples, index, neighbours: neighbours.clamp(NEIGHBOURS, crate::spatial::MAX_K) })
     }
 
+    /// The same surface with each fit made over `neighbours` samples (clamped as in [`Self::new`]).
+    pub fn with_neighbours(mut self, neighbours: usize) -> Self {
+        self.neighbours = neighbours.clamp(NEIGHBOURS, crate::spatial::MAX_K);
+        self
+    }
+
+    /// The samples' positions, indexed (in the order of the samples given to [`Self::new`]).
+    pub fn index(&self) -> &KdTree {
+        &self.index
+    }
+
     /// The mean signed distance from `p` to the tangent planes of its [`SIDE_NEIGHBOURS`]
     /// nearest samples: positive on their normals' side.
     pub fn plane_side(&self, p: Vec3) -> f32 {

@@ -13,7 +13,7 @@
 //! ([`leaf_fit`](super::leaf_fit)) where they determine one, else onto the leaf's tangent plane.
 
 use super::adjacency::Rows;
-use super::base_mesh::t_node_at;
+use super::cluster::t_node_at;
 use super::leaf_fit::QuadraticPatch;
 use crate::progress::Threads;
 use crate::quadric::CellStats;

@@ -1,6 +1,7 @@
-//! Trimming an open output back to its samples: the polygonisation carries the surface past
-//! the last samples by up to the support's reach.
+//! Stage 4: an open output trimmed back to its samples: the polygonisation carries the
+//! surface past the last samples by up to the support's reach.
 
+use super::lookup::Lookup;
 use super::{adjacency, renumber_used_vertices, support};
 use crate::mesh::Mesh;
 use crate::progress::Threads;
@@ -9,11 +10,26 @@ use crate::topology;
 use glam::Vec3;
 use rayon::prelude::*;
 
+/// An open output's border is cut back to this many sample spacings from the samples (see
+/// [`border`]): the samples cannot place a border more finely than their spacing, and within
+/// one spacing of the last samples the cut would wander with each gap between them.
+const BORDER_TRIM: f32 = 2.0;
 /// Bisection steps when a border corner slides back (see [`border`]): to 1/256 of its edge.
 const BORDER_SLIDE_STEPS: usize = 8;
 
+/// Trims an open output: an explicit `trim` (in `grid_cell`s) removes every face farther than
+/// it from the samples; otherwise the border is cut back to [`BORDER_TRIM`] sample spacings
+/// past the last samples. How many faces went.
+pub(super) fn open_output(mesh: &mut Mesh, near: &Lookup, trim: f32, grid_cell: f32, threads: &Threads) -> usize {
+    if trim > 0.0 {
+        far_faces(mesh, near.index(), trim * grid_cell, threads)
+    } else {
+        border(mesh, near.index(), BORDER_TRIM * near.spacing, threads)
+    }
+}
+
 /// Removes the faces whose centroid is farther than `distance` from every sample; how many.
-pub(super) fn far_faces(mesh: &mut Mesh, samples: &KdTree, distance: f32, threads: &Threads) -> usize {
+fn far_faces(mesh: &mut Mesh, samples: &KdTree, distance: f32, threads: &Threads) -> usize {
     let far: Vec<bool> = threads.run(|| {
         mesh.triangles
             .par_iter()
@@ -35,7 +51,7 @@ pub(super) fn far_faces(mesh: &mut Mesh, samples: &KdTree, distance: f32, thread
 /// would be wrong); then each border corner still farther slides along the surface towards
 /// its near neighbours until it is `distance` away. Removing faces alone leaves the border
 /// ragged by a face's size, which is many sample spacings on a smooth, densely sampled part.
-pub(super) fn border(mesh: &mut Mesh, samples: &KdTree, distance: f32, threads: &Threads) -> usize {
+fn border(mesh: &mut Mesh, samples: &KdTree, distance: f32, threads: &Threads) -> usize {
     let near = |p: Vec3| samples.any_within(p, distance);
     let vertex_near: Vec<bool> = threads.run(|| mesh.positions.par_iter().map(|&p| near(p)).collect());
     let far: Vec<bool> = mesh.triangles.iter().map(|t| t.iter().all(|&v| !vertex_near[v as usize])).collect();
