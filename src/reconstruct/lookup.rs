@@ -30,10 +30,10 @@ pub(super) struct Lookup<'t> {
 
 impl<'t> Lookup<'t> {
     pub fn new(tree: &'t VsTree, threads: &Threads) -> Result<Lookup<'t>> {
-        let fit = mls::SampleSurface::new(&tree.samples, mls::NEIGHBOURS, threads)?;
+        let fit = mls::SampleSurface::new(&tree.samples, threads)?;
         let tree_order: Vec<Vec3> = tree.samples.iter().map(|s| s.position).collect();
         let spacing = sample_spacing(fit.index(), &tree_order);
-        let fit = fit.with_neighbours(fit_neighbours(tree.noise, spacing));
+        let fit = fit.with_neighbours(fit_neighbours(tree.noise, spacing), threads)?;
         let typical_t_half =
             median(tree.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| n.half).collect());
         Ok(Lookup { tree, fit, spacing, typical_t_half })

@@ -36,7 +36,8 @@ pub(crate) fn improve(s: &mut Surface, onto: &SampleSurface, reach: f32, threads
     let border = crate::topology::border_vertices(&s.triangles, s.positions.len());
     for _ in 0..ROUNDS {
         flip_edges(s);
-        relax(s, &border, threads);
+        let neighbours = Rows::neighbours(&s.triangles, s.positions.len());
+        relax(s, &neighbours, &border, threads);
         project_vertices(s, 0, onto, reach, threads);
     }
 }
@@ -48,8 +49,10 @@ pub(crate) fn improve(s: &mut Surface, onto: &SampleSurface, reach: f32, threads
 pub(crate) fn relax_level(s: &mut Surface, first: usize, border: &[bool], threads: &Threads) {
     let mut fixed = border.to_vec();
     fixed[..first].fill(true);
+    // The triangles stay the same while the vertices move: the rings are found once.
+    let neighbours = Rows::neighbours(&s.triangles, s.positions.len());
     for _ in 0..LEVEL_ROUNDS {
-        relax(s, &fixed, threads);
+        relax(s, &neighbours, &fixed, threads);
     }
 }
 
@@ -133,8 +136,7 @@ fn flip_edges(s: &mut Surface) {
 
 /// Moves every vertex not on the border [`RELAX_STEP`] of the way to the mean of its
 /// neighbours, within its tangent plane.
-fn relax(s: &mut Surface, fixed: &[bool], threads: &Threads) {
-    let neighbours = Rows::neighbours(&s.triangles, s.positions.len());
+fn relax(s: &mut Surface, neighbours: &Rows, fixed: &[bool], threads: &Threads) {
     let moved: Vec<Vec3> = threads.run(|| {
         (0..s.positions.len())
             .into_par_iter()
@@ -203,7 +205,7 @@ mod tests {
         };
         let samples = sphere_samples(20_000, 1.0);
         let threads = Threads::new(1).unwrap();
-        let onto = SampleSurface::new(&samples, crate::reconstruct::mls::NEIGHBOURS, &threads).unwrap();
+        let onto = SampleSurface::new(&samples, &threads).unwrap();
         let before = thin_share(&s, 20.0);
         improve(&mut s, &onto, 0.1, &threads);
         let after = thin_share(&s, 20.0);

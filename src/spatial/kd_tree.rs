@@ -124,19 +124,40 @@ impl Cell {
     }
 }
 
-/// The k best candidates so far, sorted by (distance, index).
+/// Above this many neighbours the candidates are kept in a binary heap rather than a sorted
+/// list: an insertion into the sorted list shifts up to k entries, which dominated queries of a
+/// few hundred neighbours (the noisy clouds' local fits), while at k of a few tens the sorted
+/// list is as fast. Both give the same set, sorted the same way once the search is done.
+const HEAP_ABOVE: usize = 32;
+
+/// A candidate's place in the (squared distance, input index) order as one integer: squared
+/// distances are never negative (nor NaN), and the bits of non-negative floats order as they do.
+#[inline(always)]
+fn order_key(d2: f32, id: u32) -> u64 {
+    (u64::from(d2.to_bits()) << 32) | u64::from(id)
+}
+
+/// The squared distance and input index of an [`order_key`].
+#[inline(always)]
+fn from_key(key: u64) -> (f32, u32) {
+    (f32::from_bits((key >> 32) as u32), key as u32)
+}
+
+/// The k best candidates so far: sorted by (distance, index), or for k above [`HEAP_ABOVE`] a
+/// max-heap on (distance, index) until [`Best::finish`] sorts it.
 struct Best {
     k: usize,
-    /// (squared distance, input index, position in the tree).
-    items: Vec<(f32, u32, u32)>,
+    /// ([`order_key`], position in the tree).
+    items: Vec<(u64, u32)>,
     /// The squared distance a candidate must not exceed to be considered: the k-th best's,
     /// infinite until there are k.
     bound: f32,
+    heap: bool,
 }
 
 impl Best {
     fn new(k: usize) -> Best {
-        Best { k, items: Vec::with_capacity(k + 1), bound: f32::INFINITY }
+        Best { k, items: Vec::with_capacity(k + 1), bound: f32::INFINITY, heap: k > HEAP_ABOVE }
     }
 
     fn clear(&mut self) {
@@ -149,27 +170,79 @@ impl Best {
         self.bound
     }
 
+    /// Sorts the candidates by (distance, index) (a no-op for the sorted list).
+    fn finish(&mut self) {
+        if self.heap {
+            self.items.sort_unstable_by_key(|item| item.0);
+        }
+    }
+
     #[inline(always)]
     fn offer(&mut self, d2: f32, id: u32, position: u32) {
+        let key = order_key(d2, id);
+        if self.heap {
+            self.offer_heap((key, position));
+            return;
+        }
         if self.items.len() == self.k {
-            let (worst_d2, worst_id, _) = self.items[self.k - 1];
-            if d2 > worst_d2 || (d2 == worst_d2 && id > worst_id) {
+            if key > self.items[self.k - 1].0 {
                 return;
             }
             self.items.pop();
         }
         let mut at = self.items.len();
-        while at > 0 {
-            let (d, i, _) = self.items[at - 1];
-            if d < d2 || (d == d2 && i < id) {
-                break;
-            }
+        while at > 0 && self.items[at - 1].0 > key {
             at -= 1;
         }
-        self.items.insert(at, (d2, id, position));
+        self.items.insert(at, (key, position));
         if self.items.len() == self.k {
-            self.bound = self.items[self.k - 1].0;
+            self.bound = from_key(self.items[self.k - 1].0).0;
         }
+    }
+
+    /// [`Best::offer`] on the max-heap: the worst candidate at the root.
+    #[inline]
+    fn offer_heap(&mut self, item: (u64, u32)) {
+        let items = &mut self.items;
+        if items.len() < self.k {
+            // Sift up.
+            let mut at = items.len();
+            items.push(item);
+            while at > 0 {
+                let parent = (at - 1) / 2;
+                if item.0 < items[parent].0 {
+                    break;
+                }
+                items[at] = items[parent];
+                at = parent;
+            }
+            items[at] = item;
+            if items.len() == self.k {
+                self.bound = from_key(items[0].0).0;
+            }
+            return;
+        }
+        if item.0 > items[0].0 {
+            return;
+        }
+        // Replace the root and sift down.
+        let n = items.len();
+        let mut at = 0;
+        loop {
+            let left = 2 * at + 1;
+            if left >= n {
+                break;
+            }
+            let right = left + 1;
+            let child = if right < n && items[right].0 > items[left].0 { right } else { left };
+            if items[child].0 < item.0 {
+                break;
+            }
+            items[at] = items[child];
+            at = child;
+        }
+        items[at] = item;
+        self.bound = from_key(items[0].0).0;
     }
 }
 
@@ -293,7 +366,14 @@ impl KdTree {
         }
         let mut best = Best::new(k);
         self.search(p.to_array(), u32::MAX, &mut best);
-        best.items.iter().map(|&(d2, id, _)| Neighbour { index: id, distance_squared: d2 }).collect()
+        best.finish();
+        best.items
+            .iter()
+            .map(|&(key, _)| {
+                let (d2, id) = from_key(key);
+                Neighbour { index: id, distance_squared: d2 }
+            })
+            .collect()
     }
 
     /// For every input point, the input indices of its `k` nearest *other* points (the point
@@ -345,8 +425,9 @@ impl KdTree {
                 let position = first + chunk * BATCH + r;
                 best.clear();
                 self.search(self.entries[position].p, position as u32, &mut best);
+                best.finish();
                 for (o, item) in row.iter_mut().zip(&best.items) {
-                    *o = item.2;
+                    *o = item.1;
                 }
             }
         });
@@ -387,6 +468,24 @@ impl KdTree {
             pending.extend([(2 * node + 1, begin, mid), (2 * node + 2, mid, end)]);
         }
         Ok(())
+    }
+
+    /// The tree's nodes at the shallowest depth whose nodes hold at most `most` points each, as
+    /// ranges of tree positions (see [`KdTree::index`]): compact groups of nearby points, half
+    /// to all of `most` points each (fewer where the tree is smaller).
+    pub(crate) fn groups(&self, most: usize) -> Vec<std::ops::Range<usize>> {
+        let all: std::ops::Range<usize> = 0..self.entries.len();
+        let mut ranges = vec![all];
+        while ranges.iter().any(|r| r.len() > most.max(1)) {
+            ranges = ranges
+                .into_iter()
+                .flat_map(|r| {
+                    let mid = r.start + r.len() / 2;
+                    [r.start..mid, mid..r.end]
+                })
+                .collect();
+        }
+        ranges
     }
 
     /// The point at tree position `position`.
@@ -520,7 +619,7 @@ mod tests {
             let mut rng = Rng::new(9);
             for _ in 0..200 {
                 let q = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 8.0 - 1.0;
-                for k in [1, 5, 17] {
+                for k in [1, 5, 17, 33, 100, 450] {
                     let got: Vec<(f32, u32)> = tree.knn(q, k).iter().map(|n| (n.distance_squared, n.index)).collect();
                     assert_eq!(got, oracle(&points, q, k, None), "q {q} k {k}");
                 }
@@ -530,8 +629,7 @@ mod tests {
 
     #[test]
     fn knn_all_matches_brute_force_and_skips_only_self() {
-        for points in [random_points(2000, 2), tied_points()] {
-            let k = 10;
+        for (points, k) in [(random_points(2000, 2), 10), (tied_points(), 10), (random_points(2000, 3), 64)] {
             let all = knn_all(&points, k).unwrap();
             assert_eq!(all.len(), points.len() * k);
             for (i, row) in all.chunks(k).enumerate() {
