@@ -689,3 +689,32 @@ fn the_adaptive_base_mesh_keeps_a_ring_thinner_than_its_cells() {
     let (_, hausdorff) = chamfer_and_hausdorff(&mesh, &truth, 100_000, 1);
     assert!(hausdorff < 0.01, "Hausdorff {hausdorff:.3e}");
 }
+
+#[test]
+fn a_small_dense_part_beside_a_sparse_one_comes_out_whole() {
+    // A very uneven T-layer: a torus 0.05 across sampled 100 times as densely as a sphere 2
+    // across beside it. Its T-nodes are hundreds of times smaller than the sphere's; both come
+    // out closed with their own genus, on their surfaces.
+    let sphere = sphere_points(5_000, |_| true);
+    let (major, minor, centre) = (0.02, 0.006, Vec3::new(1.5, 0.0, 0.0));
+    let mut torus = shapes::sample_surface(&shapes::torus(major, minor, 64, 32), 500_000, 3);
+    torus.positions.iter_mut().for_each(|p| *p += centre);
+    let mut cloud = sphere.clone();
+    cloud.positions.extend(&torus.positions);
+    cloud.normals.as_mut().unwrap().extend(torus.normals.as_ref().unwrap());
+    let (mesh, stats) = run(&cloud, &ReconstructParams::default());
+    let report = topology::analyze(&mesh);
+    let mut parts = report.component_euler_characteristics.clone();
+    parts.sort_unstable();
+    assert!(report.is_watertight() && parts == [0, 2], "{report:?}");
+    let off_surface = |p: Vec3| {
+        let q = p - centre;
+        if q.length() < 0.1 {
+            ((Vec3::new(q.x, q.y, 0.0).length() - major).hypot(q.z) - minor).abs() / minor
+        } else {
+            (p.length() - 1.0).abs()
+        }
+    };
+    let worst = mesh.positions.iter().map(|&p| off_surface(p)).fold(0.0, f32::max);
+    assert!(worst < 0.1, "a vertex {worst} off its surface (in the torus's tube radii or the sphere's radius)");
+}
