@@ -702,7 +702,7 @@ fn a_small_dense_part_beside_a_sparse_one_comes_out_whole() {
     let mut cloud = sphere.clone();
     cloud.positions.extend(&torus.positions);
     cloud.normals.as_mut().unwrap().extend(torus.normals.as_ref().unwrap());
-    let (mesh, stats) = run(&cloud, &ReconstructParams::default());
+    let (mesh, _) = run(&cloud, &ReconstructParams::default());
     let report = topology::analyze(&mesh);
     let mut parts = report.component_euler_characteristics.clone();
     parts.sort_unstable();
