@@ -5,7 +5,7 @@
 
 use super::lookup::Lookup;
 use super::prepare::keep_unmarked;
-use super::{adjacency, cluster, dual_contour, field, on_grid, refine, support};
+use super::{adjacency, cluster, dual_contour, field, on_grid, refine, support, thicken};
 use super::{BaseMesh, Closure, ReconstructParams, ReconstructStats};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -101,6 +101,9 @@ pub(super) fn build(
             too_sparse_or_unoriented(tree, stats)
         )));
     }
+    if !on_grid {
+        at_sample_centroids(tree, &mut base);
+    }
     stats.base_vertices = base.mesh.positions.len();
     stats.base_triangles = base.mesh.triangles.len();
     let report = topology::analyze(&base.mesh);
@@ -149,7 +152,7 @@ struct Polygonisation<'a> {
 /// The implicit function's zero set, polygonised, and what the base mesh needs of it.
 struct Polygonised {
     fine: Mesh,
-    /// Thickened: see `on_grid::THICKEN_CELLS`.
+    /// Thickened: see [`thicken`].
     thickened: bool,
     /// Made on the uniform grid rather than over the tree's octree.
     on_grid: bool,
@@ -168,12 +171,20 @@ impl Polygonisation<'_> {
         // Where the adaptive polygonisation cannot make a 2-manifold even with its finest
         // leaves (sheets closer than the samples resolve), the grid's is used.
         let contour = match self.kind {
-            BaseMesh::Adaptive => dual_contour::contour(tree, &|p| self.field.at(p, open), self.unit, threads),
+            BaseMesh::Adaptive => {
+                let at_offset = |offset: f32| {
+                    dual_contour::contour(tree, &|p| self.field.at(p, open) - offset, self.unit, threads)
+                        .map(|c| (Mesh::new(c.positions, None, c.triangles), c.labels))
+                };
+                at_offset(0.0).map(|plain| thicken::where_handles(plain, at_offset, self.unit, threads))
+            }
             _ => None,
         };
         let on_grid = contour.is_none();
         let (fine, labels, thickened) = match contour {
-            Some(c) => (Mesh::new(c.positions, None, c.triangles), Some(c.labels), false),
+            // Moved back from the offset, a vertex lies in another leaf than the one it came
+            // from: it is labelled where it lies.
+            Some(((fine, labels), thickened)) => (fine, (!thickened).then_some(labels), thickened),
             None => {
                 let (fine, thickened) = on_grid::polygonise(self.grid, tree, self.field, open, threads)?;
                 (fine, None, thickened)
@@ -244,4 +255,23 @@ fn plane_sags(tree: &VsTree, threads: &Threads) -> Vec<f32> {
             })
             .collect()
     })
+}
+
+/// Moves each M0 vertex that alone stands for its T-node, away from the border, to the centroid
+/// of the T-node's samples (its frame's origin). Over the octree a vertex is the mean of the
+/// points where the surface crosses its T-node's edges: on a cube as large as a T-node, that
+/// mean lies inside a curved or creased surface by up to the cube's sag, where the samples'
+/// centroid lies on their plane. A T-node with several vertices keeps them where they are
+/// (moving them to one point would fold M0).
+fn at_sample_centroids(tree: &VsTree, base: &mut cluster::Clustered) {
+    let mut count: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    for &t in &base.labels {
+        *count.entry(t).or_default() += 1;
+    }
+    let border = topology::border_vertices(&base.mesh.triangles, base.mesh.positions.len());
+    for (v, &t) in base.labels.iter().enumerate() {
+        if count[&t] == 1 && !border[v] && t != cluster::UNLABELLED {
+            base.mesh.positions[v] = tree.frames[tree.nodes[t as usize].frame as usize].origin;
+        }
+    }
 }

@@ -43,6 +43,7 @@ mod refine;
 mod relax;
 mod support;
 mod t_layer;
+mod thicken;
 mod trim;
 mod winding;
 

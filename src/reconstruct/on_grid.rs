@@ -1,13 +1,12 @@
 //! The base mesh's implicit function polygonised on a uniform grid as fine as the deepest
 //! T-node ([`crate::polygonise`]), thickened where the plain polygonisation has handles.
 
-use super::adjacency;
 use super::field::Field;
+use super::thicken;
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::polygonise::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
 use crate::progress::Threads;
-use crate::topology;
 use crate::tree::{NodeKind, TreeSample, VsTree};
 use rayon::prelude::*;
 
@@ -15,17 +14,6 @@ use rayon::prelude::*;
 /// T-layer: a shape that is a height field over large T-nodes (a hemisphere is one at depth 2)
 /// is otherwise polygonised on a grid too coarse to tell its own shape, or where the samples end.
 const MIN_GRID_DEPTH: u32 = 6;
-/// Where the polygonisation has handles, it is made again this many grid cells outside the
-/// zero set, and kept if that has fewer handles, with its vertices moved back by as much. The
-/// grid's points sample a part thinner than about a cell on one side only, so such a part (a
-/// plate thinner than a cell; an ear where overlapping scans disagree by about a cell) comes
-/// out perforated, with spurious handles. Offset, the part is thick enough
-/// for the grid; moving the vertices back puts the surface where the samples are and cannot
-/// change the topology. Gaps narrower than twice the offset close, but they are below what the
-/// grid resolves faithfully anyway. Surfaces without handles are never thickened.
-const THICKEN_CELLS: f32 = 1.5;
-/// Ring averages of the fine mesh's normals before its vertices are moved back.
-const NORMAL_SMOOTHING_PASSES: usize = 2;
 /// The polygonisation gives up beyond this many grid cells along the surface.
 const MAX_GRID_CELLS: usize = 50_000_000;
 
@@ -46,8 +34,7 @@ pub(super) fn grid(tree: &VsTree, max_depth: u32, spacing: f32) -> Grid {
 }
 
 /// The zero set of `field` (for a closed or an `open` output) polygonised on `grid`, tracked
-/// from the cells of `tree`'s samples, and whether it was thickened: where it has handles, the
-/// thickened one is kept if it has fewer (see [`THICKEN_CELLS`]), its vertices moved back.
+/// from the cells of `tree`'s samples, and whether it was thickened ([`thicken`]).
 pub(super) fn polygonise(
     grid: &Grid,
     tree: &VsTree,
@@ -60,43 +47,15 @@ pub(super) fn polygonise(
         let seeds = sample_cells(grid, &tree.samples, offset, threads);
         track_surface(&|p| field.at(p, open) - offset, grid, &seeds, MAX_GRID_CELLS, threads)
     };
-    let fine = at_offset(0.0)?;
-    let genus = topology::closed_surface_genus(&fine);
-    if genus > 0 {
-        // A thickened surface too large for the grid budget is no reason to fail: the plain
-        // one stands.
-        if let Ok(mut thick) = at_offset(THICKEN_CELLS * grid.cell) {
-            if !thick.triangles.is_empty() && topology::closed_surface_genus(&thick) < genus {
-                move_inward(&mut thick, THICKEN_CELLS * grid.cell, threads);
-                return Ok((thick, true));
-            }
-        }
-    }
-    Ok((fine, false))
-}
-
-/// Moves every vertex `distance` against its normal: back from the offset the polygonisation
-/// was made at onto the implicit function's zero set (near the samples the blended planes are
-/// a signed distance). A marching-tetrahedra vertex's own normal is noisy (slivers), so each
-/// normal is averaged over its ring first. Only positions change, so the topology stays.
-fn move_inward(mesh: &mut Mesh, distance: f32, threads: &Threads) {
-    let neighbours = adjacency::Rows::neighbours(&mesh.triangles, mesh.positions.len());
-    let mut normals = mesh.area_weighted_normals();
-    for _ in 0..NORMAL_SMOOTHING_PASSES {
-        normals = threads.run(|| {
-            (0..normals.len() as u32)
-                .into_par_iter()
-                .map(|v| {
-                    neighbours
-                        .of(v)
-                        .iter()
-                        .fold(normals[v as usize], |sum, &w| sum + normals[w as usize])
-                        .normalize_or_zero()
-                })
-                .collect()
-        });
-    }
-    threads.run(|| mesh.positions.par_iter_mut().zip(&normals).for_each(|(p, n)| *p -= distance * *n));
+    // A thickened surface too large for the grid budget is no reason to fail: the plain one
+    // stands.
+    let ((mesh, ()), thickened) = thicken::where_handles(
+        (at_offset(0.0)?, ()),
+        |offset| at_offset(offset).ok().map(|m| (m, ())),
+        grid.cell,
+        threads,
+    );
+    Ok((mesh, thickened))
 }
 
 /// The grid cells that hold the samples moved `offset` along their normals: where the surface
