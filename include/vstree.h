@@ -70,7 +70,7 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 6
+#define VSTREE_VERSION_MINOR 7
 
 /**
  * Patch version (semver).
@@ -111,7 +111,8 @@
 
 /**
  * `base_mesh` value: the points' winding number says inside or outside, the distance to the
- * nearest point how far (the default).
+ * nearest point how far, polygonised on a grid as fine as the smallest T-node (the default
+ * before 0.7.0).
  */
 #define VSTREE_BASE_MESH_WINDING 0
 
@@ -122,7 +123,8 @@
 
 /**
  * `base_mesh` value: the winding number's side, polygonised over the tree's octree with each
- * region at its own T-node's size instead of on a grid as fine as the smallest. Since 0.6.0.
+ * region at its own T-node's size instead of on a grid as fine as the smallest; an open output
+ * is still made on the grid. The default since 0.7.0. Since 0.6.0.
  */
 #define VSTREE_BASE_MESH_ADAPTIVE 2
 
@@ -1002,9 +1004,10 @@ typedef struct vstree_reconstruct_params {
    */
   int32_t closure;
   /**
-   * What decides the base mesh's inside and outside, a VSTREE_BASE_MESH_* value. Default
-   * VSTREE_BASE_MESH_WINDING; VSTREE_BASE_MESH_PAPER is the paper's construction, to compare
-   * with. Since 0.2.0.
+   * What decides the base mesh's inside and outside, and how it is polygonised, a
+   * VSTREE_BASE_MESH_* value. Default VSTREE_BASE_MESH_ADAPTIVE (since 0.7.0;
+   * VSTREE_BASE_MESH_WINDING before); VSTREE_BASE_MESH_PAPER is the paper's construction, to
+   * compare with. Since 0.2.0.
    */
   int32_t base_mesh;
 } vstree_reconstruct_params;

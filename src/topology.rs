@@ -112,10 +112,10 @@ fn sorted_half_edges(faces: &[[u32; 3]]) -> Vec<HalfEdge> {
     half_edges
 }
 
-/// The genus summed over the components of a mesh that is known to be a closed 2-manifold
-/// (as the polygoniser makes it): components − χ/2, in one pass and without the checks of
-/// [`analyze`]. For any other mesh the figure means nothing.
-pub(crate) fn closed_surface_genus(mesh: &Mesh) -> i64 {
+/// The components of a mesh that is known to be a closed 2-manifold (as the polygoniser makes
+/// it), and the genus summed over them: components − χ/2, in one pass and without the checks
+/// of [`analyze`]. For any other mesh the figures mean nothing.
+pub(crate) fn closed_surface_parts_and_genus(mesh: &Mesh) -> (i64, i64) {
     let mut components = UnionFind::new(mesh.positions.len());
     let mut used = vec![false; mesh.positions.len()];
     for t in &mesh.triangles {
@@ -128,7 +128,7 @@ pub(crate) fn closed_surface_genus(mesh: &Mesh) -> i64 {
         (0..mesh.positions.len() as u32).filter(|&v| used[v as usize] && components.find(v) == v).count() as i64;
     // Closed: every edge has two faces, E = 3F/2, so χ = V − F/2.
     let chi = vertices - mesh.triangles.len() as i64 / 2;
-    count - chi / 2
+    (count, count - chi / 2)
 }
 
 /// Computes the [`TopologyReport`] of `mesh`. Point clouds (no triangles) give a report with zero
@@ -389,16 +389,19 @@ mod tests {
     }
 
     #[test]
-    fn closed_surface_genus_agrees_with_the_full_analysis() {
+    fn closed_surface_parts_and_genus_agree_with_the_full_analysis() {
         use crate::eval::shapes;
         let mut two_shapes = shapes::torus(1.0, 0.3, 24, 12);
         let double = shapes::double_torus();
         let offset = two_shapes.positions.len() as u32;
         two_shapes.positions.extend(double.positions.iter().map(|p| *p + Vec3::splat(5.0)));
         two_shapes.triangles.extend(double.triangles.iter().map(|t| t.map(|v| v + offset)));
-        for (mesh, genus) in [(shapes::icosphere(1.0, 2), 0), (shapes::torus(1.0, 0.3, 24, 12), 1), (two_shapes, 3)] {
+        for (mesh, parts, genus) in
+            [(shapes::icosphere(1.0, 2), 1, 0), (shapes::torus(1.0, 0.3, 24, 12), 1, 1), (two_shapes, 2, 3)]
+        {
             assert_eq!(analyze(&mesh).genus(), Some(genus as u32));
-            assert_eq!(closed_surface_genus(&mesh), genus);
+            assert_eq!(analyze(&mesh).components, parts as usize);
+            assert_eq!(closed_surface_parts_and_genus(&mesh), (parts, genus));
         }
     }
 

@@ -168,7 +168,7 @@ enum Command {
         #[arg(long, hide = true)]
         detect_open: bool,
         /// What decides the base mesh's inside and outside.
-        #[arg(long, value_enum, default_value_t = BaseMeshArg::Winding)]
+        #[arg(long, value_enum, default_value_t = BaseMeshArg::Adaptive)]
         base_mesh: BaseMeshArg,
         /// Re-orient the normals the cloud already has (consistent by spanning-tree
         /// propagation, then facing outward). Clouds without normals always get them estimated.
@@ -277,12 +277,13 @@ enum MetricArg {
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum BaseMeshArg {
     /// The points' winding number says inside or outside, the distance to the nearest point how
-    /// far: robust topology on thin parts and narrow gaps, details down to the point spacing.
+    /// far, polygonised on a grid as fine as the smallest T-node (the default before 0.7.0).
     Winding,
     /// The paper's construction: the T-nodes' planes blended near the points (to compare with).
     Paper,
     /// The winding number's side, polygonised over the tree's octree, each region at its own
-    /// T-node's size (the field evaluated at the T-layer's corners, not on a fine grid).
+    /// T-node's size (the field evaluated at the T-layer's corners, not on a fine grid; an open
+    /// output is made on the grid). The default.
     Adaptive,
 }
 

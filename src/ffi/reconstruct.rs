@@ -74,19 +74,22 @@ pub struct vstree_reconstruct_params {
     /// 0.3.0; VSTREE_CLOSURE_CLOSED before): a scan from one side comes out open, a closed
     /// object closed. Since 0.2.0.
     pub closure: i32,
-    /// What decides the base mesh's inside and outside, a VSTREE_BASE_MESH_* value. Default
-    /// VSTREE_BASE_MESH_WINDING; VSTREE_BASE_MESH_PAPER is the paper's construction, to compare
-    /// with. Since 0.2.0.
+    /// What decides the base mesh's inside and outside, and how it is polygonised, a
+    /// VSTREE_BASE_MESH_* value. Default VSTREE_BASE_MESH_ADAPTIVE (since 0.7.0;
+    /// VSTREE_BASE_MESH_WINDING before); VSTREE_BASE_MESH_PAPER is the paper's construction, to
+    /// compare with. Since 0.2.0.
     pub base_mesh: i32,
 }
 
 /// `base_mesh` value: the points' winding number says inside or outside, the distance to the
-/// nearest point how far (the default).
+/// nearest point how far, polygonised on a grid as fine as the smallest T-node (the default
+/// before 0.7.0).
 pub const VSTREE_BASE_MESH_WINDING: i32 = 0;
 /// `base_mesh` value: the paper's blend of the T-nodes' planes near the points.
 pub const VSTREE_BASE_MESH_PAPER: i32 = 1;
 /// `base_mesh` value: the winding number's side, polygonised over the tree's octree with each
-/// region at its own T-node's size instead of on a grid as fine as the smallest. Since 0.6.0.
+/// region at its own T-node's size instead of on a grid as fine as the smallest; an open output
+/// is still made on the grid. The default since 0.7.0. Since 0.6.0.
 pub const VSTREE_BASE_MESH_ADAPTIVE: i32 = 2;
 
 /// `closure` value: open when more than 30% of the closed surface is unsupported by the points

@@ -21,6 +21,21 @@ use rayon::prelude::*;
 /// under 10 degrees on the fandisk view, against 20%), no limit a Chamfer 1.7x larger there.
 const BORDER_RUN: f32 = 1.0;
 
+/// A face of the octree's polygonisation is judged supported or not at most this many points
+/// along an edge (this squared over the face): a face in the empty space behind a scan can be
+/// hundreds of reaches across, and a few hundred points tell its share as well as more.
+const MOST_ACROSS: usize = 16;
+
+/// How far from the samples, in T-node plane sags, a point of a face over the octree may lie
+/// and still be supported: the vertex at either end of a chord across two neighbouring T-nodes
+/// lies inside the surface by up to one sag, and the chord, twice a T-node's length, sags four.
+const CHORD_SAGS: f32 = 5.0;
+
+/// Samples in front of a T-node face it when their normals' cosine to its normal is below this
+/// (120 degrees): two sheets facing each other across a gap. Curved or noisy samples of the
+/// T-node's own sheet turn by less.
+const OPPOSED: f32 = -0.5;
+
 /// M0, with what the later stages measure against.
 pub(super) struct Base {
     pub surface: refine::Surface,
@@ -62,11 +77,19 @@ pub(super) fn build(
     // Open asked for; `Auto` first polygonises as for a closed output and, if that finds an
     // open scan, again as for an open one.
     let asked_open = params.closure == Closure::Open || params.trim > 0.0;
-    let mut part = polygonisation.run(asked_open)?;
+    let mut part = polygonisation.run(asked_open, true)?;
+    // Where the octree's coarse band along a border leaves it undecided, the grid's finer one
+    // decides.
+    if params.closure == Closure::Auto && !asked_open && !part.on_grid {
+        let [low, high] = [part.share, part.share_high].map(|s| support::is_open(params.closure, s));
+        if low != high {
+            part.share = polygonisation.run(false, false)?.share;
+        }
+    }
     stats.unsupported_share = part.share;
     let open = asked_open || support::is_open(params.closure, part.share);
     if open && !asked_open {
-        part = polygonisation.run(true)?;
+        part = polygonisation.run(true, false)?;
     }
     drop(polygonisation);
     progress.report(0.4, "base mesh")?;
@@ -162,21 +185,35 @@ struct Polygonised {
     /// Faces no sample supports, and their share of the area.
     unsupported: Vec<bool>,
     share: f64,
+    /// The share with the faces next to unsupported ones counted as unsupported too.
+    share_high: f64,
 }
 
 impl Polygonisation<'_> {
     /// The zero set for a closed or an `open` output.
-    fn run(&self, open: bool) -> Result<Polygonised> {
+    fn run(&self, open: bool, octree: bool) -> Result<Polygonised> {
         let (tree, threads) = (self.tree, self.threads);
-        // Where the adaptive polygonisation cannot make a 2-manifold even with its finest
-        // leaves (sheets closer than the samples resolve), the grid's is used.
+        // Over the octree for a closed output; where the adaptive polygonisation cannot make a
+        // 2-manifold even with its finest leaves (sheets closer than the samples resolve), and
+        // for an open one, on the grid: an open output is the supported part of the zero set,
+        // cut along faces, and the octree's faces in the empty space behind a scan are as large
+        // as the space is, so its border would be as coarse.
         let contour = match self.kind {
-            BaseMesh::Adaptive => {
+            BaseMesh::Adaptive if octree && !open => {
+                let facing = |centre: glam::Vec3, radius: f32, t: u32| {
+                    let frame = &tree.frames[tree.nodes[t as usize].frame as usize];
+                    let index = self.near.index();
+                    index.any_within_among(centre, radius, |i| {
+                        let s = &tree.samples[i as usize];
+                        s.normal.dot(frame.normal) < OPPOSED && frame.height(s.position) > 0.0
+                    })
+                };
                 let at_offset = |offset: f32| {
-                    dual_contour::contour(tree, &|p| self.field.at(p, open) - offset, self.unit, threads)
+                    dual_contour::contour(tree, &|p| self.field.at(p, open) - offset, &facing, self.unit, threads)
                         .map(|c| (Mesh::new(c.positions, None, c.triangles), c.labels))
                 };
-                at_offset(0.0).map(|plain| thicken::where_handles(plain, at_offset, self.unit, threads))
+                at_offset(0.0)
+                    .map(|plain| thicken::where_handles(plain, at_offset, self.unit, Some(self.smallest_hole), threads))
             }
             _ => None,
         };
@@ -209,23 +246,61 @@ impl Polygonisation<'_> {
             None => threads.run(|| cluster::label_vertices(tree, &fine, &neighbours)),
         };
         let reach = support::SUPPORT_REACH * self.unit;
-        // A face of the adaptive polygonisation spans whole T-nodes, so its centre is as far
-        // from the surface as a chord of that length sags: up to half its longest edge.
-        let chord = |f: usize| {
-            let [a, b, c] = fine.triangles[f].map(|v| fine.positions[v as usize]);
-            0.5 * a.distance(b).max(b.distance(c)).max(c.distance(a))
-        };
+        // A face over the octree joins the vertices of neighbouring T-nodes, each inside the
+        // surface by up to its T-node's sag: a chord twice as long sags four times as much.
+        let sags = if on_grid { 1.0 } else { CHORD_SAGS };
         let face_reach = |f: usize| {
-            let sag = self.sag.get(labels[fine.triangles[f][0] as usize] as usize).copied().unwrap_or(0.0);
-            reach + sag + if self.kind == BaseMesh::Adaptive { chord(f) } else { 0.0 }
+            let sag = fine.triangles[f]
+                .iter()
+                .map(|&v| self.sag.get(labels[v as usize] as usize).copied().unwrap_or(0.0))
+                .fold(0.0, f32::max);
+            reach + sags * sag
         };
-        let support = support::supported_faces(&fine, self.near.index(), &self.sample_normals, face_reach, threads);
+        // Its inside is judged at points a reach apart across it, as the grid's small faces are.
+        let across = |f: usize| {
+            if on_grid {
+                return 1;
+            }
+            let [a, b, c] = fine.triangles[f].map(|v| fine.positions[v as usize]);
+            let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
+            ((longest / face_reach(f)).ceil() as usize).clamp(1, MOST_ACROSS)
+        };
+        let support =
+            support::supported_faces(&fine, self.near.index(), &self.sample_normals, face_reach, across, threads);
         // Faces that no sample supports: far from all, or near only samples facing the other
         // way (the closing sheet right behind an open scan).
-        let unsupported: Vec<bool> = support.iter().map(|&s| s != support::Support::Supported).collect();
-        let unsupported = support::without_small_regions(&fine, &unsupported, self.smallest_hole);
-        let share = support::unsupported_share(&fine, &unsupported);
-        Ok(Polygonised { fine, thickened, on_grid, neighbours, labels, unsupported, share })
+        let unsupported: Vec<bool> = support.iter().map(|&(s, _)| s != support::Support::Supported).collect();
+        let kept = support::without_small_regions(&fine, &unsupported, self.smallest_hole);
+        // The share counts the part of a supported face that is not supported, and none of a
+        // region too small to count.
+        let weights: Vec<f32> = (0..kept.len())
+            .map(|f| {
+                if kept[f] {
+                    1.0
+                } else if unsupported[f] {
+                    0.0
+                } else {
+                    support[f].1
+                }
+            })
+            .collect();
+        let mut next_to_unsupported = vec![false; fine.positions.len()];
+        for (t, _) in fine.triangles.iter().zip(&kept).filter(|(_, &k)| k) {
+            t.iter().for_each(|&v| next_to_unsupported[v as usize] = true);
+        }
+        let share = support::unsupported_share(&fine, &weights);
+        // The band where the closed surface turns behind the samples' border is a face wide:
+        // on the grid a cell, over the octree a T-node, which on a coarse T-layer is a fifth of
+        // a hemisphere's area. Counted as unsupported too, it bounds the share from above.
+        let band: Vec<f32> = fine
+            .triangles
+            .iter()
+            .zip(&weights)
+            .map(|(t, &w)| if t.iter().any(|&v| next_to_unsupported[v as usize]) { 1.0 } else { w })
+            .collect();
+        let share_high = support::unsupported_share(&fine, &band);
+        let unsupported = kept;
+        Ok(Polygonised { fine, thickened, on_grid, neighbours, labels, unsupported, share, share_high })
     }
 }
 

@@ -66,15 +66,18 @@ pub(crate) struct Contour {
 
 /// Polygonises the zero set of `f` (negative inside) over the octree of `tree`'s T-layer; `None`
 /// when the result is not a 2-manifold. No leaf is split below `finest` (world units): the
-/// samples resolve nothing smaller.
+/// samples resolve nothing smaller. `opposed(centre, radius, t)` says whether samples of
+/// another sheet than T-node `t`'s lie within `radius` of `centre`, facing it across a gap.
 pub(crate) fn contour(
     tree: &VsTree,
     f: &(dyn Fn(Vec3) -> f32 + Sync),
+    opposed: &(dyn Fn(Vec3, f32, u32) -> bool + Sync),
     finest: f32,
     threads: &Threads,
 ) -> Option<Contour> {
     let mut octree = Octree::new(tree);
     let finest_level = (KEY_BITS - 1).saturating_sub((finest / octree.unit).max(1.0).log2().floor() as u32);
+    octree.split_where_opposed(opposed, finest_level, threads);
     // Leaves whose vertices the polygons do not join into a 2-manifold (a leaf crossed by
     // sheets that its boundary's loops do not tell apart) are split, as far as levels allow.
     let mut rounds = 0;
@@ -173,6 +176,46 @@ impl<'t> Octree<'t> {
 
     fn inside(&self, key: u64) -> bool {
         self.values[&key] < 0.0
+    }
+
+    /// Splits the T-nodes' leaves, down to `finest_level`, while another sheet faces the
+    /// T-node's within a leaf's side of its centre: a gap narrower than the leaf is seen by no
+    /// corner of it, and the handle it makes closes, until the leaves are as small as it.
+    fn split_where_opposed(
+        &mut self,
+        opposed: &(dyn Fn(Vec3, f32, u32) -> bool + Sync),
+        finest_level: u32,
+        threads: &Threads,
+    ) {
+        loop {
+            let tree = self.tree;
+            let leaves: Vec<u32> = (0..self.cells.len() as u32)
+                .filter(|&c| {
+                    let cell = &self.cells[c as usize];
+                    cell.children == NONE
+                        && cell.level < finest_level
+                        && cell.node != NONE
+                        && tree.nodes[cell.node as usize].kind == NodeKind::Transition
+                })
+                .collect();
+            let split: Vec<u32> = threads.run(|| {
+                leaves
+                    .into_par_iter()
+                    .filter(|&c| {
+                        let cell = &self.cells[c as usize];
+                        let side = self.unit * self.size(cell.level) as f32;
+                        let centre = self.origin + self.unit * cell.min.as_vec3() + Vec3::splat(0.5 * side);
+                        opposed(centre, side, cell.node)
+                    })
+                    .collect()
+            });
+            if split.is_empty() {
+                return;
+            }
+            for c in split {
+                self.split(c);
+            }
+        }
     }
 
     /// Splits a leaf into eight in the same tree node.
@@ -516,8 +559,8 @@ mod tests {
         let samples = SampleSet::from_cloud(&cloud).unwrap();
         let threads = Threads::new(0).unwrap();
         let t = tree::build(&samples, &TreeParams::default(), &threads, &mut Progress::none()).unwrap();
-        assert!(contour(&t, &wobble, 10.0, &threads).is_none(), "no split needed");
-        let c = contour(&t, &wobble, 1e-4, &threads).expect("repaired by splits");
+        assert!(contour(&t, &wobble, &|_, _, _| false, 10.0, &threads).is_none(), "no split needed");
+        let c = contour(&t, &wobble, &|_, _, _| false, 1e-4, &threads).expect("repaired by splits");
         let report = topology::analyze(&Mesh::new(c.positions, None, c.triangles));
         assert!(report.is_watertight() && report.non_manifold_vertices == 0, "{report:?}");
     }

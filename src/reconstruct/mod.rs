@@ -8,8 +8,9 @@
 //!    de-noising control for what the noise does not explain) ([`t_layer`]);
 //! 2. the base mesh M0, one vertex per T-node ([`base_mesh`]): an implicit function whose sign
 //!    is inside or outside ([`field`]; by default the samples' winding number, [`winding`]) is
-//!    polygonised over the tree's octree ([`dual_contour`]) or on a grid as fine as the deepest
-//!    T-node ([`on_grid`]) and clustered at the T-layer ([`cluster`]);
+//!    polygonised over the tree's octree ([`dual_contour`], the default for a closed output)
+//!    or on a grid as fine as the deepest T-node ([`on_grid`]; an open output, and where the
+//!    octree's polygonisation is no 2-manifold) and clustered at the T-layer ([`cluster`]);
 //! 3. refinement ([`levels`]): split 1-to-4 on PN triangles and displace by the quadtrees
 //!    ([`refine`]); every vertex of M0 and of each level is then projected onto a local
 //!    quadratic fit of its nearest samples ([`mls`]; more of them the noisier the cloud), until

@@ -53,6 +53,7 @@ pub(super) fn polygonise(
         (at_offset(0.0)?, ()),
         |offset| at_offset(offset).ok().map(|m| (m, ())),
         grid.cell,
+        None,
         threads,
     );
     Ok((mesh, thickened))

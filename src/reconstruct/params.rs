@@ -13,8 +13,7 @@ pub enum BaseMesh {
     /// The samples' winding number gives the side everywhere, the distance to the nearest
     /// sample the value. The winding number is a property of the whole cloud, so the topology
     /// does not depend on how large the T-nodes near a thin part or a narrow gap are, and the
-    /// distance keeps details down to the sample spacing. The default.
-    #[default]
+    /// distance keeps details down to the sample spacing.
     Winding,
     /// The paper's §5.2: the T-nodes' planes blended by a partition of unity near the samples
     /// (the winding number only decides beyond them). Kept to compare with.
@@ -22,6 +21,8 @@ pub enum BaseMesh {
     /// The winding number's side, polygonised over the tree's own octree with the T-nodes as
     /// cells (dual contouring, see `dual_contour`) instead of on a grid as fine as the deepest
     /// T-node: each region at its own T-node's size, the field evaluated at the T-layer's corners.
+    /// The default.
+    #[default]
     Adaptive,
 }
 
@@ -74,7 +75,7 @@ impl Default for ReconstructParams {
             max_grid_depth: 10,
             trim: 0.0,
             closure: Closure::Auto,
-            base_mesh: BaseMesh::Winding,
+            base_mesh: BaseMesh::default(),
             normals: NormalParams::default(),
             threads: 0,
         }

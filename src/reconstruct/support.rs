@@ -61,46 +61,84 @@ pub(super) enum Support {
 }
 
 /// Per face of `mesh`: how the samples of `samples` (normals `normals`, in the same order)
-/// support it, within `reach(face)` of its centre. The face's normal is its corners'
-/// area-weighted normals (the polygonisation's own faces are often slivers).
+/// support it, within `reach(face)` of the centres of the `across(face)`^2 triangles that
+/// cutting each edge in `across(face)` parts makes (1: the face's centre), by a majority of
+/// those, and the share of those it is not supported at. A face judged at its centre takes
+/// its corners' area-weighted normals (the polygonisation's own faces are often slivers).
 pub(super) fn supported_faces(
     mesh: &Mesh,
     samples: &KdTree,
     normals: &[Vec3],
     reach: impl Fn(usize) -> f32 + Sync,
+    across: impl Fn(usize) -> usize + Sync,
     threads: &Threads,
-) -> Vec<Support> {
+) -> Vec<(Support, f32)> {
     let vertex_normals = mesh.area_weighted_normals();
     threads.run(|| {
         mesh.triangles
             .par_iter()
             .enumerate()
             .map(|(f, t)| {
-                let centre = t.iter().map(|&v| mesh.positions[v as usize]).sum::<Vec3>() / 3.0;
-                let n = t.iter().map(|&v| vertex_normals[v as usize]).sum::<Vec3>().normalize_or_zero();
-                if !samples.any_within(centre, reach(f)) {
-                    Support::Far
-                } else if samples.any_within_among(centre, reach(f), |i| normals[i as usize].dot(n) > SUPPORT_AGREEMENT)
-                {
+                let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+                let across = across(f).max(1);
+                // A face judged at several points is large: its own normal says where it faces,
+                // where its corners' would blend in the faces around it.
+                let own = (b - a).cross(c - a);
+                let n = if across > 1 && own.length() > 0.1 * (b - a).length_squared().max((c - a).length_squared()) {
+                    own.normalize()
+                } else {
+                    t.iter().map(|&v| vertex_normals[v as usize]).sum::<Vec3>().normalize_or_zero()
+                };
+                let reach = reach(f);
+                let at = |p: Vec3| {
+                    if !samples.any_within(p, reach) {
+                        Support::Far
+                    } else if samples.any_within_among(p, reach, |i| normals[i as usize].dot(n) > SUPPORT_AGREEMENT) {
+                        Support::Supported
+                    } else {
+                        Support::Turned
+                    }
+                };
+                let mut counts = [0usize; 3];
+                for (u, v) in sub_triangle_centres(across) {
+                    counts[at(a + u * (b - a) + v * (c - a)) as usize] += 1;
+                }
+                let [far, turned, supported] = counts;
+                let all = far + turned + supported;
+                let verdict = if 2 * supported >= all {
                     Support::Supported
+                } else if far >= turned {
+                    Support::Far
                 } else {
                     Support::Turned
-                }
+                };
+                (verdict, (far + turned) as f32 / all as f32)
             })
             .collect()
     })
 }
 
-/// The share of `mesh`'s area in the faces that `marked` marks.
-pub(super) fn unsupported_share(mesh: &Mesh, marked: &[bool]) -> f64 {
+/// The barycentric coordinates (of the second and third corner) of the centres of the n^2
+/// triangles that cutting a triangle's edges in `n` parts makes.
+fn sub_triangle_centres(n: usize) -> impl Iterator<Item = (f32, f32)> {
+    let n_f = n as f32;
+    (0..n).flat_map(move |i| {
+        (0..n - i).flat_map(move |j| {
+            let up = ((i as f32 + 1.0 / 3.0) / n_f, (j as f32 + 1.0 / 3.0) / n_f);
+            let down = ((i as f32 + 2.0 / 3.0) / n_f, (j as f32 + 2.0 / 3.0) / n_f);
+            std::iter::once(up).chain((i + j + 1 < n).then_some(down))
+        })
+    })
+}
+
+/// The share of `mesh`'s area that `marked` marks: per face, the share of it marked.
+pub(super) fn unsupported_share(mesh: &Mesh, marked: &[f32]) -> f64 {
     let (mut all, mut part) = (0.0f64, 0.0f64);
     for (t, &m) in mesh.triangles.iter().zip(marked) {
         let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
         let area = f64::from((b - a).cross(c - a).length());
         all += area;
-        if m {
-            part += area;
-        }
+        part += area * f64::from(m);
     }
     if all > 0.0 {
         part / all
@@ -185,8 +223,8 @@ mod tests {
         let sphere = icosphere(1.0, 4);
         let upper: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z > 0.0).collect();
         let threads = Threads::new(1).unwrap();
-        let support = supported_faces(&sphere, &KdTree::new(&upper).unwrap(), &upper, |_| 0.05, &threads);
-        let unsupported: Vec<bool> = support.iter().map(|&s| s == Support::Far).collect();
+        let support = supported_faces(&sphere, &KdTree::new(&upper).unwrap(), &upper, |_| 0.05, |_| 1, &threads);
+        let unsupported: Vec<f32> = support.iter().map(|&(s, _)| f32::from(u8::from(s == Support::Far))).collect();
         let share = unsupported_share(&sphere, &unsupported);
         assert!((share - 0.5).abs() < 0.05, "{share}");
         assert!(is_open(Closure::Auto, share));
@@ -199,8 +237,8 @@ mod tests {
         let sphere = icosphere(1.0, 4);
         let kept: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z <= 0.9).collect();
         let threads = Threads::new(1).unwrap();
-        let support = supported_faces(&sphere, &KdTree::new(&kept).unwrap(), &kept, |_| 0.05, &threads);
-        let unsupported: Vec<bool> = support.iter().map(|&s| s == Support::Far).collect();
+        let support = supported_faces(&sphere, &KdTree::new(&kept).unwrap(), &kept, |_| 0.05, |_| 1, &threads);
+        let unsupported: Vec<f32> = support.iter().map(|&(s, _)| f32::from(u8::from(s == Support::Far))).collect();
         let share = unsupported_share(&sphere, &unsupported);
         assert!(share > 0.02 && share < 0.08, "{share}");
         assert!(!is_open(Closure::Auto, share));
@@ -215,8 +253,9 @@ mod tests {
         let threads = Threads::new(1).unwrap();
         for (top, open) in [(0.5, false), (0.0, true)] {
             let kept: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z <= top).collect();
-            let support = supported_faces(&sphere, &KdTree::new(&kept).unwrap(), &kept, |_| 0.05, &threads);
-            let unsupported: Vec<bool> = support.iter().map(|&s| s != Support::Supported).collect();
+            let support = supported_faces(&sphere, &KdTree::new(&kept).unwrap(), &kept, |_| 0.05, |_| 1, &threads);
+            let unsupported: Vec<f32> =
+                support.iter().map(|&(s, _)| f32::from(u8::from(s != Support::Supported))).collect();
             let share = unsupported_share(&sphere, &unsupported);
             assert_eq!(is_open(Closure::default(), share), open, "{share} unsupported");
         }
@@ -229,9 +268,9 @@ mod tests {
         let upper: Vec<Vec3> = sphere.positions.iter().copied().filter(|p| p.z > 0.0).collect();
         let down: Vec<Vec3> = upper.iter().map(|_| -Vec3::Z).collect();
         let threads = Threads::new(1).unwrap();
-        let support = supported_faces(&sphere, &KdTree::new(&upper).unwrap(), &down, |_| 0.2, &threads);
+        let support = supported_faces(&sphere, &KdTree::new(&upper).unwrap(), &down, |_| 0.2, |_| 1, &threads);
         let centre = |t: &[u32; 3]| t.iter().map(|&v| sphere.positions[v as usize]).sum::<Vec3>() / 3.0;
-        for (t, s) in sphere.triangles.iter().zip(&support) {
+        for (t, (s, _)) in sphere.triangles.iter().zip(&support) {
             let z = centre(t).z;
             if z > 0.1 {
                 assert_eq!(*s, Support::Turned, "z {z}");
@@ -273,5 +312,30 @@ mod tests {
             dome.triangles.iter().map(|t| t.iter().any(|&v| dome.positions[v as usize].z < 0.1)).collect();
         assert!(!regions(&dome, &near_pole).1[0].touches_border);
         assert!(regions(&dome, &near_rim).1.iter().all(|r| r.touches_border));
+    }
+
+    #[test]
+    fn a_large_face_is_judged_across_its_area() {
+        // One triangle over a square of samples of which only the half x < 0 is sampled: its
+        // centre (x = 0.33) sees no sample; 8 x 8 points across it see the half it covers.
+        let samples: Vec<Vec3> = (0..200 * 200)
+            .map(|i| Vec3::new(-2.0 + 0.01 * (i % 200) as f32, -1.0 + 0.01 * (i / 200) as f32, 0.0))
+            .filter(|p| p.x < 0.0)
+            .collect();
+        let normals = vec![Vec3::Z; samples.len()];
+        let face = Mesh::new(
+            vec![Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0)],
+            None,
+            vec![[0, 1, 2]],
+        );
+        let index = KdTree::new(&samples).unwrap();
+        let threads = Threads::new(1).unwrap();
+        let at_centre = supported_faces(&face, &index, &normals, |_| 0.05, |_| 1, &threads)[0];
+        assert_eq!(at_centre, (Support::Far, 1.0));
+        let (verdict, unsupported) = supported_faces(&face, &index, &normals, |_| 0.05, |_| 8, &threads)[0];
+        // The triangle's part at x < 0 is a quarter of it.
+        assert!(verdict == Support::Far && (unsupported - 0.75).abs() < 0.1, "{verdict:?} {unsupported}");
+        assert_eq!(sub_triangle_centres(8).count(), 64);
+        assert!(sub_triangle_centres(8).all(|(u, v)| u > 0.0 && v > 0.0 && u + v < 1.0));
     }
 }

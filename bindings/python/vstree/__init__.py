@@ -714,10 +714,10 @@ def reconstruct(cloud, normals=None, progress=None, **params):
     ``max_triangles``, ``max_grid_depth`` (4-20; default 10), ``closure`` ("auto", the default: open
     where much of the closed surface is far from every point, as behind a scan from one side |
     "closed": always closed, holes closed over | "open": only the part of the surface the
-    points support, holes kept), ``base_mesh`` ("winding", the
-    default: the points' winding number decides inside and outside | "paper": the paper's
-    blended T-node planes | "adaptive": the winding number's side polygonised over the tree's
-    octree, each region at its own T-node's size), ``trim`` (grid cells: every face farther goes; 0, the default,
+    points support, holes kept), ``base_mesh`` ("adaptive", the
+    default: the points' winding number decides inside and outside, polygonised over the tree's
+    octree, each region at its own T-node's size | "winding": the same side on a grid as fine as
+    the smallest T-node | "paper": the paper's blended T-node planes), ``trim`` (grid cells: every face farther goes; 0, the default,
     trims only past an open scan's border), ``d_a``, ``d_d``, ``max_depth``, ``min_cell_size``, ``orient``
     ("propagate_outward" | "propagate" | "propagate_majority" | "unoriented"), ``neighbours``,
     ``reorient_given``, ``threads``.
