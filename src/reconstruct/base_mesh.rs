@@ -39,6 +39,14 @@ const CHORD_SAGS: f32 = 5.0;
 /// clouds, 0.10).
 const OCTREE_DOUBT: f64 = 2.0 / 3.0;
 
+/// When the grid measures the open share again, its surface replaces the octree's if its
+/// unsupported share is below this fraction of the octree's: a share several times smaller means
+/// the octree's cells crossed empty space (cheese: 0.04 against 0.36), while shares this close
+/// differ by the two bands only, and the octree's surface is the better one (a box at 20k points:
+/// 0.23 on the grid, whose surface has two spurious handles; pinned by
+/// `closed_solids_with_sharp_creases_stay_closed`).
+const GRID_KEPT_BELOW: f64 = 0.5;
+
 /// Samples in front of a T-node face it when their normals' cosine to its normal is below this
 /// (120 degrees): two sheets facing each other across a gap. Curved or noisy samples of the
 /// T-node's own sheet turn by less.
@@ -87,17 +95,16 @@ pub(super) fn build(
     let asked_open = params.closure == Closure::Open || params.trim > 0.0;
     let mut part = polygonisation.run(asked_open, true)?;
     // Where the octree's coarse band along a border leaves it in doubt, the grid's finer one
-    // decides. Where the grid's surface has less than half the octree's area away from the
-    // samples, the octree's cells crossed empty space (walls thinner than a T-node between
-    // holes: cheese's 36% against the grid's 4%), and the grid's is kept; closer shares are the
-    // two bands' difference (a box at 20k points: the grid's 23% has two spurious handles).
+    // decides. Where the grid's surface has much less area away from the
+    // samples, the octree's cells crossed empty space, and the grid's is kept (see
+    // GRID_KEPT_BELOW).
     if params.closure == Closure::Auto
         && !asked_open
         && !part.on_grid
         && part.share > OCTREE_DOUBT * support::OPEN_SHARE
     {
         let grid_part = polygonisation.run(false, false)?;
-        if grid_part.share < 0.5 * part.share {
+        if grid_part.share < GRID_KEPT_BELOW * part.share {
             part = grid_part;
         } else {
             part.share = grid_part.share;

@@ -554,22 +554,34 @@ mod tests {
     use crate::tree::{self, TreeParams};
     use crate::{Mesh, Progress, SampleSet};
 
+    /// The field of an axis-aligned cube of side 1 (negative inside).
+    fn cube(p: Vec3) -> f32 {
+        p.abs().max_element() - 0.5
+    }
+
+    /// The tree of 50k samples on that cube.
+    fn cube_tree(threads: &Threads) -> VsTree {
+        let cloud =
+            shapes::sample_surface(&shapes::implicit_mesh(cube, Vec3::splat(-1.0), Vec3::splat(1.0), 128), 50_000, 1);
+        let samples = SampleSet::from_cloud(&cloud).unwrap();
+        tree::build(&samples, &TreeParams::default(), threads, &mut Progress::none()).unwrap()
+    }
+
+    fn assert_closed_2_manifold(c: Contour) {
+        let report = topology::analyze(&Mesh::new(c.positions, None, c.triangles));
+        assert!(report.is_watertight() && report.non_manifold_vertices == 0, "{report:?}");
+    }
+
     #[test]
     fn leaves_at_non_manifold_vertices_are_split_until_the_surface_is_a_2_manifold() {
         // A cube whose field wobbles by 3% of its side, as the winding number's side wobbles
         // near noisy or sharp samples: over the T-layer's leaves some vertices are non-manifold
         // (no result when no leaf may be split), and splitting those leaves repairs them.
-        let cube = |p: Vec3| p.abs().max_element() - 0.5;
         let wobble = |p: Vec3| cube(p) + 0.03 * (p.x * 91.0).sin() * (p.y * 77.0).sin() * (p.z * 83.0).sin();
-        let cloud =
-            shapes::sample_surface(&shapes::implicit_mesh(cube, Vec3::splat(-1.0), Vec3::splat(1.0), 128), 50_000, 1);
-        let samples = SampleSet::from_cloud(&cloud).unwrap();
         let threads = Threads::new(0).unwrap();
-        let t = tree::build(&samples, &TreeParams::default(), &threads, &mut Progress::none()).unwrap();
+        let t = cube_tree(&threads);
         assert!(contour(&t, &wobble, &|_, _, _| false, 10.0, &threads).is_none(), "no split needed");
-        let c = contour(&t, &wobble, &|_, _, _| false, 1e-4, &threads).expect("repaired by splits");
-        let report = topology::analyze(&Mesh::new(c.positions, None, c.triangles));
-        assert!(report.is_watertight() && report.non_manifold_vertices == 0, "{report:?}");
+        assert_closed_2_manifold(contour(&t, &wobble, &|_, _, _| false, 1e-4, &threads).expect("repaired by splits"));
     }
 
     #[test]
@@ -577,17 +589,12 @@ mod tests {
         // A cube whose field wobbles faster (a sixth of the side a period) and no leaf to be
         // split below twice the smallest T-node: the wobble's sheets pass within those leaves,
         // and only the repair levels below them tell them apart (REPAIR_LEVELS 0 gives none).
-        let cube = |p: Vec3| p.abs().max_element() - 0.5;
         let wobble = |p: Vec3| cube(p) + 0.03 * (p.x * 136.5).sin() * (p.y * 115.5).sin() * (p.z * 124.5).sin();
-        let cloud =
-            shapes::sample_surface(&shapes::implicit_mesh(cube, Vec3::splat(-1.0), Vec3::splat(1.0), 128), 50_000, 1);
-        let samples = SampleSet::from_cloud(&cloud).unwrap();
         let threads = Threads::new(0).unwrap();
-        let t = tree::build(&samples, &TreeParams::default(), &threads, &mut Progress::none()).unwrap();
+        let t = cube_tree(&threads);
         let smallest =
             t.nodes.iter().filter(|n| n.kind == NodeKind::Transition).map(|n| 2.0 * n.half).fold(f32::MAX, f32::min);
         let c = contour(&t, &wobble, &|_, _, _| false, 2.0 * smallest, &threads).expect("repaired below the finest");
-        let report = topology::analyze(&Mesh::new(c.positions, None, c.triangles));
-        assert!(report.is_watertight() && report.non_manifold_vertices == 0, "{report:?}");
+        assert_closed_2_manifold(c);
     }
 }
