@@ -12,6 +12,7 @@ pub mod eval;
 pub mod ffi;
 pub mod io;
 mod linalg;
+mod memory;
 pub mod mesh;
 pub mod normals;
 mod polygonise;

@@ -61,6 +61,7 @@ pub(super) fn refine(
         mls::project_vertices(&mut surface, first_new, fit, mls_reach, threads);
         mls::unfold(&mut surface, &border, fit, mls_reach, threads);
         stats.levels.push(level_stats);
+        crate::memory::release_freed();
         // Without a target distance only the final error is reported: no need to measure
         // each level (a hierarchy over all the triangles each time).
         if params.target_distance > 0.0 {

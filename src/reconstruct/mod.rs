@@ -76,11 +76,13 @@ pub fn reconstruct(
     let (samples, scale) =
         prepare::oriented_samples(cloud, params, &threads, &mut stats, &mut progress.stage(0.0, 0.15))?;
     stats.seconds_normals = start.elapsed().as_secs_f64();
+    crate::memory::release_freed();
 
     let t0 = Instant::now();
     let tree = t_layer::tree(&samples, params, &threads, &mut stats, &mut progress.stage(0.15, 0.35))?;
     // The tree holds the samples from here on.
     drop(samples);
+    crate::memory::release_freed();
     // Where error(M, S) is measured: in the tree's order, nearby samples one after the other,
     // so the measure finds the same parts of the mesh in cache.
     let measured: Vec<Vec3> = evenly_spread(&tree.samples, ERROR_SAMPLES).iter().map(|s| s.position).collect();
@@ -91,6 +93,7 @@ pub fn reconstruct(
     let base = base_mesh::build(&near, params, &threads, &mut stats, progress)?;
     let (open, grid_cell) = (base.open, base.grid_cell);
     stats.open = open;
+    crate::memory::release_freed();
     let t2 = Instant::now();
 
     let surface = levels::refine(base, &near, &measured, params, &threads, &mut stats, progress)?;
