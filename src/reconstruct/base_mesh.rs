@@ -21,11 +21,6 @@ use rayon::prelude::*;
 /// under 10 degrees on the fandisk view, against 20%), no limit a Chamfer 1.7x larger there.
 const BORDER_RUN: f32 = 1.0;
 
-/// A face of the octree's polygonisation is judged supported or not at most this many points
-/// along an edge (this squared over the face): a face in the empty space behind a scan can be
-/// hundreds of reaches across, and a few hundred points tell its share as well as more.
-const MOST_ACROSS: usize = 16;
-
 /// How far from the samples, in T-node plane sags, a point of a face over the octree may lie
 /// and still be supported: the vertex at either end of a chord across two neighbouring T-nodes
 /// lies inside the surface by up to one sag, and the chord, twice a T-node's length, sags four.
@@ -230,12 +225,14 @@ impl Polygonisation<'_> {
                         s.normal.dot(frame.normal) < OPPOSED && frame.height(s.position) > 0.0
                     })
                 };
-                let at_offset = |offset: f32| {
-                    dual_contour::contour(tree, &|p| self.field.at(p, open) - offset, &facing, self.unit, threads)
+                let at_offset = |lift: &(dyn Fn(glam::Vec3) -> f32 + Sync)| {
+                    dual_contour::contour(tree, &|p| self.field.at(p, open) - lift(p), &facing, self.unit, threads)
                         .map(|c| (Mesh::new(c.positions, None, c.triangles), c.labels))
                 };
-                at_offset(0.0)
-                    .map(|plain| thicken::where_handles(plain, at_offset, self.unit, Some(self.smallest_hole), threads))
+                let thin = (&tree.samples[..], self.near.index());
+                at_offset(&|_| 0.0).map(|plain| {
+                    thicken::where_handles(plain, at_offset, thin, self.unit, Some(self.smallest_hole), threads)
+                })
             }
             _ => None,
         };
@@ -245,7 +242,8 @@ impl Polygonisation<'_> {
             // from: it is labelled where it lies.
             Some(((fine, labels), thickened)) => (fine, (!thickened).then_some(labels), thickened),
             None => {
-                let (fine, thickened) = on_grid::polygonise(self.grid, tree, self.field, open, threads)?;
+                let (fine, thickened) =
+                    on_grid::polygonise(self.grid, tree, self.near.index(), self.field, open, threads)?;
                 (fine, None, thickened)
             }
         };
@@ -285,7 +283,7 @@ impl Polygonisation<'_> {
             }
             let [a, b, c] = fine.triangles[f].map(|v| fine.positions[v as usize]);
             let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
-            ((longest / face_reach(f)).ceil() as usize).clamp(1, MOST_ACROSS)
+            ((longest / face_reach(f)).ceil() as usize).clamp(1, support::MOST_ACROSS)
         };
         let mut support =
             support::supported_faces(&fine, self.near.index(), &self.sample_normals, face_reach, across, threads);

@@ -7,7 +7,9 @@ use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::polygonise::{track_surface, Grid, MAX_GRID_POINTS_PER_AXIS};
 use crate::progress::Threads;
+use crate::spatial::KdTree;
 use crate::tree::{NodeKind, TreeSample, VsTree};
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// The polygonisation grid has at least 2^this cells across the root cube, however coarse the
@@ -38,20 +40,22 @@ pub(super) fn grid(tree: &VsTree, max_depth: u32, spacing: f32) -> Grid {
 pub(super) fn polygonise(
     grid: &Grid,
     tree: &VsTree,
+    index: &KdTree,
     field: &Field,
     open: bool,
     threads: &Threads,
 ) -> Result<(Mesh, bool)> {
-    // Polygonised `offset` outside the zero set, from the cells the surface should cross.
-    let at_offset = |offset: f32| {
-        let seeds = sample_cells(grid, &tree.samples, offset, threads);
-        track_surface(&|p| field.at(p, open) - offset, grid, &seeds, MAX_GRID_CELLS, threads)
+    // Polygonised `lift` outside the zero set, from the cells the surface should cross.
+    let at_offset = |lift: &(dyn Fn(Vec3) -> f32 + Sync)| {
+        let seeds = sample_cells(grid, &tree.samples, lift, threads);
+        track_surface(&|p| field.at(p, open) - lift(p), grid, &seeds, MAX_GRID_CELLS, threads)
     };
     // A thickened surface too large for the grid budget is no reason to fail: the plain one
     // stands.
     let ((mesh, ()), thickened) = thicken::where_handles(
-        (at_offset(0.0)?, ()),
-        |offset| at_offset(offset).ok().map(|m| (m, ())),
+        (at_offset(&|_| 0.0)?, ()),
+        |lift| at_offset(lift).ok().map(|m| (m, ())),
+        (&tree.samples, index),
         grid.cell,
         None,
         threads,
@@ -59,12 +63,17 @@ pub(super) fn polygonise(
     Ok((mesh, thickened))
 }
 
-/// The grid cells that hold the samples moved `offset` along their normals: where the surface
-/// tracking starts (the function is polygonised that far outside the samples).
-fn sample_cells(grid: &Grid, samples: &[TreeSample], offset: f32, threads: &Threads) -> Vec<[u32; 3]> {
+/// The grid cells that hold the samples moved `lift` (at each) along their normals: where the
+/// surface tracking starts (the function is polygonised that far outside the samples).
+fn sample_cells(
+    grid: &Grid,
+    samples: &[TreeSample],
+    lift: &(dyn Fn(Vec3) -> f32 + Sync),
+    threads: &Threads,
+) -> Vec<[u32; 3]> {
     threads.run(|| {
         let mut cells: Vec<[u32; 3]> =
-            samples.par_iter().map(|s| grid.cell_of(s.position + offset * s.normal)).collect();
+            samples.par_iter().map(|s| grid.cell_of(s.position + lift(s.position) * s.normal)).collect();
         cells.par_sort_unstable();
         cells.dedup();
         cells

@@ -20,6 +20,11 @@ use rayon::prelude::*;
 /// sample spacings.
 pub(super) const SUPPORT_REACH: f32 = 1.0;
 
+/// A face of the octree's polygonisation is judged supported or not at most this many points
+/// along an edge (this squared over the face): a face in the empty space behind a scan can be
+/// hundreds of reaches across, and a few hundred points tell its share as well as more.
+pub(super) const MOST_ACROSS: usize = 16;
+
 /// A cloud is taken to be open when more than this share of the polygonised surface's area
 /// is unsupported (far from every sample, or near only samples facing the other way). A
 /// hemisphere closed by its disk leaves a third unsupported, the least of any scan from one
