@@ -1,7 +1,8 @@
 /**
  * \file vstree.h
- * \brief C API of vstree: Volume-Surface Trees (Boubekeur et al. 2006) for clustering mesh
- * simplification.
+ * \brief C API of vstree: Volume-Surface Trees (Boubekeur et al. 2006) for mesh
+ * simplification (vstree_simplify()) and surface reconstruction from point clouds
+ * (vstree_reconstruct()), with normal estimation for clouds that have none.
  *
  * **Versioning.** The library follows semantic versioning (VSTREE_VERSION_MAJOR/MINOR/PATCH,
  * vstree_version()). The ABI has its own number, VSTREE_ABI_VERSION, which is also the number
