@@ -28,8 +28,8 @@ pub(super) const THICKEN_CELLS: f32 = 1.5;
 /// (cosine below `OPPOSED`), lies within this many cells: the other side of a plate thinner
 /// than twice the offset, which is what the offset surface joins. A gap between sheets facing
 /// each other (a bolt hole a few samples across) is no thin part: offset near thin parts only,
-/// it stays open, where offsetting the whole surface closes it (turbine at 200k points without
-/// normals: genus 11 plain, 9 offset where thin, 1 offset everywhere). Pinned by
+/// it stays open, where offsetting the whole surface closes it (turbine at 200k points keeps
+/// its 11; offset everywhere, it has 1). Pinned by
 /// `a_plates_sides_are_thin_a_bores_wall_is_not`.
 const THIN_CELLS: f32 = 2.0 * THICKEN_CELLS;
 /// Thin parts are judged on one sample per box of this many cells (see [`one_per_box`]), a
@@ -69,8 +69,8 @@ const NORMAL_SMOOTHING_PASSES: usize = 2;
 /// `plain` (the zero set, with what came with it), or where it has handles, or with
 /// `smallest` given several parts of at least that area (smaller ones are dropped later), the
 /// zero set lifted outside by `THICKEN_CELLS * cell`, near thin parts of `samples` (indexed by
-/// `index`) or everywhere, made by `at_offset` from the lift at each point and moved back: of
-/// the first with fewer such parts, or as many and fewer handles, that the samples support
+/// `index`) or everywhere, made by `at_offset` from the lift at each point and moved back: the
+/// first with fewer such parts, or as many and fewer handles, that the samples support
 /// (see [`supported_enough`]); and whether it was thickened. Both are tried because neither
 /// mends every perforation: offset where thin keeps the narrow holes that offset everywhere
 /// closes, but sees no thin part where the field perforates a single sheet (an open scan's
