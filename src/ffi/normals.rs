@@ -2,7 +2,7 @@
 //! the call, which gives a new mesh handle (handles are immutable), and its report.
 
 use super::mesh::{into_handle, mesh_ref, vstree_mesh};
-use super::params::{self, constant_field, Versioned};
+use super::params::{self, constant_field, flag, threads, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::{guard, non_null, vstree_status, write_out, Failure, FfiResult};
 use crate::mesh::Mesh;
@@ -54,23 +54,6 @@ pub(crate) fn orientation_value(orient: Orientation) -> i32 {
         Orientation::PropagateMajority => VSTREE_ORIENTATION_PROPAGATE_MAJORITY,
         Orientation::PropagateOutward => VSTREE_ORIENTATION_PROPAGATE_OUTWARD,
     }
-}
-
-/// Checks a 0/1 field.
-pub(crate) fn flag(field: &str, value: u32) -> FfiResult<bool> {
-    match value {
-        0 => Ok(false),
-        1 => Ok(true),
-        _ => Err(Failure::parameter(field, format!("{value}: must be 0 or 1"))),
-    }
-}
-
-/// Checks a `threads` field.
-pub(crate) fn threads(value: u32) -> FfiResult<usize> {
-    if value > 1024 {
-        return Err(Failure::parameter("threads", format!("{value}: must be 0 (all cores) to 1024")));
-    }
-    Ok(value as usize)
 }
 
 /// Parameters of vstree_estimate_normals(). Always start from vstree_normal_params_default()

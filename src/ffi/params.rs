@@ -1,7 +1,8 @@
 //! Versioned parameter structs: each starts with `uint32_t struct_size`, which its `_default()`
 //! sets to the size the caller was compiled with. A library that knows a larger struct reads
 //! only the caller's prefix and keeps its defaults for the fields added since; a caller built
-//! against a newer header than the library is refused with a message saying so.
+//! against a newer header than the library is refused with a message saying so. The readers
+//! of the fields every struct shares (enums, 0/1 flags, `threads`) are here too.
 
 use super::{Failure, FfiResult};
 use std::mem::size_of;
@@ -101,4 +102,21 @@ pub(crate) use c_enum;
 /// field and every variant.
 pub(crate) fn enum_field<E: CEnum>(field: &str, value: i32) -> FfiResult<E> {
     E::from_raw(value).ok_or_else(|| not_one_of(field, value, E::VARIANTS.iter().map(|&(v, n)| (v.raw(), n))))
+}
+
+/// Checks a 0/1 field.
+pub(crate) fn flag(field: &str, value: u32) -> FfiResult<bool> {
+    match value {
+        0 => Ok(false),
+        1 => Ok(true),
+        _ => Err(Failure::parameter(field, format!("{value}: must be 0 or 1"))),
+    }
+}
+
+/// Checks a `threads` field.
+pub(crate) fn threads(value: u32) -> FfiResult<usize> {
+    if value > 1024 {
+        return Err(Failure::parameter("threads", format!("{value}: must be 0 (all cores) to 1024")));
+    }
+    Ok(value as usize)
 }

@@ -2,8 +2,8 @@
 //! handle with the output mesh and statistics.
 
 use super::mesh::{mesh_ref, vstree_mesh};
-use super::normals::{flag, orientation, orientation_value, threads};
-use super::params::{self, constant_field, Versioned};
+use super::normals::{orientation, orientation_value};
+use super::params::{self, constant_field, flag, threads, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::{guard, guard_or, handle, non_null, vstree_status, write_out, FfiResult};
 use crate::normals::NormalParams;

@@ -2,7 +2,7 @@
 //! builds the same tree), the call, and its result handle with the output mesh and statistics.
 
 use super::mesh::{mesh_ref, vstree_mesh};
-use super::params::{self, c_enum, enum_field, Versioned};
+use super::params::{self, c_enum, enum_field, threads, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::{guard, handle, non_null, vstree_status, write_out, FfiResult};
 use crate::samples::MeshSampling;
@@ -184,21 +184,13 @@ pub(crate) unsafe fn read_params(pointer: *const vstree_simplify_params) -> FfiR
         max_depth: p.max_depth,
         min_cell_size: p.min_cell_size,
     };
-    if p.threads > 1024 {
-        return Err(super::Failure::parameter("threads", format!("{}: must be 0 (all cores) to 1024", p.threads)));
-    }
+    let threads = threads(p.threads)?;
     let keep_topology = match enum_field("keep_topology", p.keep_topology)? {
         vstree_keep_topology::Auto => KeepTopology::Auto,
         vstree_keep_topology::On => KeepTopology::On,
         vstree_keep_topology::Off => KeepTopology::Off,
     };
-    let params = SimplifyParams {
-        tree,
-        sampling,
-        threads: p.threads as usize,
-        keep_topology,
-        target_faces: p.target_faces as usize,
-    };
+    let params = SimplifyParams { tree, sampling, threads, keep_topology, target_faces: p.target_faces as usize };
     params.check()?;
     Ok(params)
 }
