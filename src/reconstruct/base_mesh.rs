@@ -229,7 +229,7 @@ impl Polygonisation<'_> {
                     dual_contour::contour(tree, &|p| self.field.at(p, open) - lift(p), &facing, self.unit, threads)
                         .map(|c| (Mesh::new(c.positions, None, c.triangles), c.labels))
                 };
-                let thin = (&tree.samples[..], self.near.index());
+                let thin = (&tree.samples[..], self.near.index(), &self.sample_normals[..]);
                 at_offset(&|_| 0.0).map(|plain| {
                     thicken::where_handles(plain, at_offset, thin, self.unit, Some(self.smallest_hole), threads)
                 })
@@ -242,8 +242,14 @@ impl Polygonisation<'_> {
             // from: it is labelled where it lies.
             Some(((fine, labels), thickened)) => (fine, (!thickened).then_some(labels), thickened),
             None => {
-                let (fine, thickened) =
-                    on_grid::polygonise(self.grid, tree, self.near.index(), self.field, open, threads)?;
+                let (fine, thickened) = on_grid::polygonise(
+                    self.grid,
+                    tree,
+                    (self.near.index(), &self.sample_normals),
+                    self.field,
+                    open,
+                    threads,
+                )?;
                 (fine, None, thickened)
             }
         };
@@ -281,9 +287,7 @@ impl Polygonisation<'_> {
             if on_grid {
                 return 1;
             }
-            let [a, b, c] = fine.triangles[f].map(|v| fine.positions[v as usize]);
-            let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
-            ((longest / face_reach(f)).ceil() as usize).clamp(1, support::MOST_ACROSS)
+            support::points_across(&fine, f, face_reach(f))
         };
         let mut support =
             support::supported_faces(&fine, self.near.index(), &self.sample_normals, face_reach, across, threads);

@@ -40,7 +40,7 @@ pub(super) fn grid(tree: &VsTree, max_depth: u32, spacing: f32) -> Grid {
 pub(super) fn polygonise(
     grid: &Grid,
     tree: &VsTree,
-    index: &KdTree,
+    (index, normals): (&KdTree, &[Vec3]),
     field: &Field,
     open: bool,
     threads: &Threads,
@@ -55,7 +55,7 @@ pub(super) fn polygonise(
     let ((mesh, ()), thickened) = thicken::where_handles(
         (at_offset(&|_| 0.0)?, ()),
         |lift| at_offset(lift).ok().map(|m| (m, ())),
-        (&tree.samples, index),
+        (&tree.samples, index, normals),
         grid.cell,
         None,
         threads,

@@ -23,7 +23,15 @@ pub(super) const SUPPORT_REACH: f32 = 1.0;
 /// A face of the octree's polygonisation is judged supported or not at most this many points
 /// along an edge (this squared over the face): a face in the empty space behind a scan can be
 /// hundreds of reaches across, and a few hundred points tell its share as well as more.
-pub(super) const MOST_ACROSS: usize = 16;
+const MOST_ACROSS: usize = 16;
+
+/// How many points along an edge face `f` of `mesh` is judged at, for points `reach` apart
+/// (the `across` of [`supported_faces`]).
+pub(super) fn points_across(mesh: &Mesh, f: usize, reach: f32) -> usize {
+    let [a, b, c] = mesh.triangles[f].map(|v| mesh.positions[v as usize]);
+    let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
+    ((longest / reach).ceil() as usize).clamp(1, MOST_ACROSS)
+}
 
 /// A cloud is taken to be open when more than this share of the polygonised surface's area
 /// is unsupported (far from every sample, or near only samples facing the other way). A

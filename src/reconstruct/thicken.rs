@@ -79,7 +79,7 @@ const NORMAL_SMOOTHING_PASSES: usize = 2;
 pub(super) fn where_handles<X>(
     plain: (Mesh, X),
     at_offset: impl Fn(&(dyn Fn(Vec3) -> f32 + Sync)) -> Option<(Mesh, X)>,
-    (samples, index): (&[TreeSample], &KdTree),
+    (samples, index, normals): (&[TreeSample], &KdTree, &[Vec3]),
     cell: f32,
     smallest: Option<f64>,
     threads: &Threads,
@@ -90,8 +90,7 @@ pub(super) fn where_handles<X>(
     if plain_handles.0 <= 1 && plain_handles.1 == 0 {
         return (plain, false);
     }
-    let normals: Vec<Vec3> = samples.iter().map(|s| s.normal).collect();
-    let support = |mesh: &Mesh| Support::of(mesh, index, &normals, SUPPORT_CELLS * cell, threads);
+    let support = |mesh: &Mesh| Support::of(mesh, index, normals, SUPPORT_CELLS * cell, threads);
     let plain_support = std::cell::OnceCell::new();
     let offset = THICKEN_CELLS * cell;
     let thickened = |lift: &(dyn Fn(Vec3) -> f32 + Sync)| {
@@ -173,16 +172,16 @@ impl Support {
     /// Judged within `reach` of the samples (`index`, with their `normals`), at points `reach`
     /// apart.
     fn of(mesh: &Mesh, index: &KdTree, normals: &[Vec3], reach: f32, threads: &Threads) -> Support {
-        let across = |f: usize| {
-            let [a, b, c] = mesh.triangles[f].map(|v| mesh.positions[v as usize]);
-            let longest = a.distance(b).max(b.distance(c)).max(c.distance(a));
-            ((longest / reach).ceil() as usize).clamp(1, support::MOST_ACROSS)
-        };
-        let support = support::supported_faces(mesh, index, normals, |_| reach, across, threads);
-        let unsupported: Vec<f32> = support.iter().map(|&(_, share)| share).collect();
-        let total = area(mesh);
-        let unsupported = support::unsupported_share(mesh, &unsupported) * total;
-        Support { supported: total - unsupported, unsupported }
+        let across = |f: usize| support::points_across(mesh, f, reach);
+        let shares = support::supported_faces(mesh, index, normals, |_| reach, across, threads);
+        let mut area = Support { supported: 0.0, unsupported: 0.0 };
+        for (t, &(_, unsupported)) in mesh.triangles.iter().zip(&shares) {
+            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
+            let face = 0.5 * f64::from((b - a).cross(c - a).length());
+            area.unsupported += face * f64::from(unsupported);
+            area.supported += face * f64::from(1.0 - unsupported);
+        }
+        area
     }
 
     fn area(&self) -> f64 {
@@ -206,17 +205,6 @@ fn one_per_box<'a>(samples: &'a [TreeSample], side: f32, threads: &Threads) -> V
         keyed.dedup_by_key(|(k, _)| *k);
         keyed.iter().map(|&(_, i)| &samples[i as usize]).collect()
     })
-}
-
-/// The area of `mesh`.
-fn area(mesh: &Mesh) -> f64 {
-    mesh.triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|v| mesh.positions[v as usize]);
-            0.5 * f64::from((b - a).cross(c - a).length())
-        })
-        .sum()
 }
 
 /// How many connected parts of `mesh` have at least `smallest` area (their doubled area, as
@@ -256,14 +244,14 @@ mod tests {
 
     /// A torus of tube radius 0.3 sampled at its vertices: with cells of 0.25 its tube is a
     /// thin part (the far side lies 0.6 behind, within `THIN_CELLS`).
-    fn sampled_torus() -> (Vec<TreeSample>, KdTree) {
+    fn sampled_torus() -> (Vec<TreeSample>, KdTree, Vec<Vec3>) {
         let mesh = torus(1.0, 0.3, 96, 32);
         let normals = mesh.normals.as_ref().unwrap();
         let samples: Vec<TreeSample> = (0..mesh.positions.len())
             .map(|i| TreeSample { position: mesh.positions[i], normal: normals[i], index: i as u32 })
             .collect();
         let index = KdTree::new(&mesh.positions).unwrap();
-        (samples, index)
+        (samples, index, normals.clone())
     }
 
     /// `a` and `b` as one mesh.
@@ -306,11 +294,17 @@ mod tests {
     fn a_thickened_surface_that_caps_a_hole_without_samples_is_refused() {
         // The offset surface has no handle, but its cap over the torus' hole (and all of the
         // sphere) lies far from every sample.
-        let (samples, index) = sampled_torus();
+        let (samples, index, normals) = sampled_torus();
         let threads = Threads::new(1).unwrap();
         let plain = torus(1.0, 0.3, 96, 32);
-        let ((kept, ()), thickened) =
-            where_handles((plain, ()), |_| Some((icosphere(1.4, 4), ())), (&samples, &index), CELL, None, &threads);
+        let ((kept, ()), thickened) = where_handles(
+            (plain, ()),
+            |_| Some((icosphere(1.4, 4), ())),
+            (&samples, &index, &normals),
+            CELL,
+            None,
+            &threads,
+        );
         assert!(!thickened);
         assert_eq!(topology::closed_surface_parts_and_genus(&kept).1, 1);
     }
@@ -319,7 +313,7 @@ mod tests {
     fn a_thickened_surface_with_fewer_handles_on_the_samples_is_kept_and_moved_back() {
         // The plain surface has a spurious second handle away from the samples; the offset
         // surface is the torus one offset out, which moved back lies on the samples.
-        let (samples, index) = sampled_torus();
+        let (samples, index, normals) = sampled_torus();
         let threads = Threads::new(1).unwrap();
         let mut far = torus(0.1, 0.03, 16, 8);
         far.positions.iter_mut().for_each(|p| *p += Vec3::new(0.0, 0.0, 3.0));
@@ -330,7 +324,8 @@ mod tests {
             assert!((lift(Vec3::new(1.0, 0.0, 0.3 + offset)) - offset).abs() < 1e-6);
             Some((torus(1.0, 0.3 + offset, 96, 32), ()))
         };
-        let ((kept, ()), thickened) = where_handles((plain, ()), at_offset, (&samples, &index), CELL, None, &threads);
+        let ((kept, ()), thickened) =
+            where_handles((plain, ()), at_offset, (&samples, &index, &normals), CELL, None, &threads);
         assert!(thickened);
         assert_eq!(topology::closed_surface_parts_and_genus(&kept), (1, 1));
         let off = kept.positions.iter().map(|p| (index.distance_within(*p, 1.0)).min(1.0)).fold(0.0f32, f32::max);
