@@ -962,8 +962,9 @@ typedef struct vstree_reconstruct_params {
   double min_cell_size;
   /**
    * Refinement stops once the RMS distance from the samples to the mesh, over the
-   * bounding-box diagonal, is at most this. Finite, >= 0; default 0 (refine until the
-   * quadtrees have no detail left or `max_levels`).
+   * bounding-box diagonal, is at most this, and each level splits only the regions whose
+   * samples are farther than this from them (an adaptive mesh). Finite, >= 0; default 0
+   * (refine everywhere until the quadtrees have no detail left or `max_levels`).
    */
   double target_distance;
   /**
@@ -1031,7 +1032,8 @@ typedef struct vstree_reconstruct_stats {
    */
   int32_t base_genus;
   /**
-   * Refinement levels done (each splits every triangle in 4).
+   * Refinement levels done (each splits every triangle in 4, or with a target distance those
+   * whose samples are farther from them than the target).
    */
   uint32_t levels;
   /**

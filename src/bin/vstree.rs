@@ -144,7 +144,8 @@ enum Command {
         #[command(flatten)]
         tree: TreeArgs,
         /// Stop refining once the RMS distance from the samples to the mesh is at most this
-        /// fraction of the bounding-box diagonal (0 = refine while the tree has detail left).
+        /// fraction of the bounding-box diagonal, splitting only the regions whose samples are
+        /// farther than this (0 = refine everywhere while the tree has detail left).
         #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().target_distance)]
         target: f64,
         /// Most refinement levels (each one multiplies the triangles by 4).
@@ -721,7 +722,13 @@ fn print_reconstruct(
     say!("{polygonised}, field evaluated at {} points", s.field_evaluations);
     say!("M0: {} vertices, {} triangles, {genus}, error {:.2e}", s.base_vertices, s.base_triangles, s.base_error);
     for (k, level) in s.levels.iter().enumerate() {
-        say!("level {}: {} new vertices, {} displaced by the quadtrees", k + 1, level.new_vertices, level.displaced);
+        say!(
+            "level {}: {} triangles split, {} new vertices, {} displaced by the quadtrees",
+            k + 1,
+            level.split,
+            level.new_vertices,
+            level.displaced
+        );
     }
     if s.stopped == RefinementStop::TriangleBudget {
         warn!(

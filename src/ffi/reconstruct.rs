@@ -49,8 +49,9 @@ pub struct vstree_reconstruct_params {
     /// default 1e-7.
     pub min_cell_size: f64,
     /// Refinement stops once the RMS distance from the samples to the mesh, over the
-    /// bounding-box diagonal, is at most this. Finite, >= 0; default 0 (refine until the
-    /// quadtrees have no detail left or `max_levels`).
+    /// bounding-box diagonal, is at most this, and each level splits only the regions whose
+    /// samples are farther than this from them (an adaptive mesh). Finite, >= 0; default 0
+    /// (refine everywhere until the quadtrees have no detail left or `max_levels`).
     pub target_distance: f64,
     /// A level that displaces fewer than this fraction of its new vertices ends refinement.
     /// Unitless, in [0, 1]; default 0.02.
@@ -229,7 +230,8 @@ pub struct vstree_reconstruct_stats {
     pub grid_cells: u32,
     /// Genus of the base mesh M0, or -1 when M0 is not a closed manifold.
     pub base_genus: i32,
-    /// Refinement levels done (each splits every triangle in 4).
+    /// Refinement levels done (each splits every triangle in 4, or with a target distance those
+    /// whose samples are farther from them than the target).
     pub levels: u32,
     /// Deepest level of the tree (the root is level 0).
     pub max_depth: u32,

@@ -55,6 +55,21 @@ impl Rows {
         rows
     }
 
+    /// Each of `count` items' partners in `pairs`, both ways.
+    pub fn from_pairs(pairs: &[[u32; 2]], count: usize) -> Rows {
+        Rows::build(count, |pair| {
+            for &[a, b] in pairs {
+                pair(a, b);
+                pair(b, a);
+            }
+        })
+    }
+
+    /// The number of rows.
+    pub fn len(&self) -> usize {
+        self.first.len() - 1
+    }
+
     pub fn of(&self, v: u32) -> &[u32] {
         &self.items[self.first[v as usize] as usize..self.first[v as usize + 1] as usize]
     }

@@ -1,11 +1,16 @@
 //! Stage 3: refinement. M0 is snapped onto its T-nodes' patches, projected onto the samples'
-//! local fits ([`mls`]) and remeshed ([`relax`]); then level after level is split 1-to-4 on
-//! PN triangles and displaced by the quadtrees ([`refine`]), its new vertices relaxed and
-//! projected and its folds unfolded, until the mesh is close enough to the samples or the
-//! quadtrees have no detail left.
+//! local fits ([`mls`]) and remeshed ([`relax`]); then level after level is split 1-to-4 on PN
+//! triangles and displaced by the quadtrees ([`refine`]), the new vertices relaxed and projected
+//! and folds unfolded, until the mesh is close enough to the samples or the quadtrees have no
+//! detail left. Without a target distance every triangle is split at every level; with one,
+//! only the regions of M0 ([`Regions`]) whose samples are still farther from their triangles
+//! than the target, so that the triangles go where the detail is, with crack-free transitions
+//! ([`red_green`](super::red_green)) between regions that stopped at different levels.
 
+use super::adjacency::Rows;
 use super::base_mesh::Base;
 use super::lookup::Lookup;
+use super::regions::{Regions, REGION_TRIANGLES};
 use super::{mls, refine, relax, ReconstructParams, ReconstructStats, RefinementStop};
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -20,7 +25,7 @@ use rayon::prelude::*;
 /// to a T-node's sag off the surface; a longer move would reach another part of it.
 const MLS_REACH: f32 = 2.0;
 
-/// M0 refined; error(M, S) is measured at `measured`.
+/// M0 refined; error(M, S) is measured at `measured`, which also say where to refine.
 pub(super) fn refine(
     base: Base,
     near: &Lookup,
@@ -39,61 +44,154 @@ pub(super) fn refine(
     let fit = &near.fit;
     mls::project_vertices(&mut surface, 0, fit, mls_reach, threads);
     relax::improve(&mut surface, fit, mls_reach, threads);
-    let (mut rms, mut max) = sample_error(&mut surface, measured, tree.diagonal, threads);
-    stats.base_error = rms;
+    let gap_of = |s: &mut refine::Surface| Gap::measure(s, measured, threads);
+    let mut gap = gap_of(&mut surface);
+    stats.base_error = gap.rms / f64::from(tree.diagonal);
+    // In the samples' units.
+    let target = (params.target_distance * f64::from(tree.diagonal)) as f32;
     stats.stopped = RefinementStop::MaxLevels;
+    let mut greens = Vec::new();
+    // Per triangle: the region of M0 it is part of; a region refines as a whole.
+    let regions =
+        Regions::grow(surface.triangles.len(), &topology::adjacent_face_pairs(&surface.triangles), REGION_TRIANGLES);
+    let mut region = regions.of_triangle.clone();
+    let mut measured_now = true;
     for level in 0..params.max_levels {
-        // M0 itself may be close enough; after a level the check below decides.
-        if level == 0 && rms <= params.target_distance {
+        if measured_now && gap.rms <= f64::from(target) {
             stats.stopped = RefinementStop::Target;
             break;
         }
-        if 4 * surface.triangles.len() > params.max_triangles {
+        let marked = if target > 0.0 {
+            let mut region_far = vec![false; regions.count()];
+            for (t, &(count, sum_sq)) in gap.nearest.iter().enumerate() {
+                region_far[region[t] as usize] |= count > 0 && sum_sq > target * target * count as f32;
+            }
+            fill_gaps(&mut region_far, &regions.neighbours);
+            region.iter().map(|&r| region_far[r as usize]).collect()
+        } else {
+            vec![true; surface.triangles.len()]
+        };
+        let to_split = marked.iter().filter(|&&far| far).count();
+        if to_split == 0 {
+            stats.stopped = RefinementStop::Target;
+            break;
+        }
+        if surface.triangles.len() + 3 * to_split > params.max_triangles {
             stats.stopped = RefinementStop::TriangleBudget;
             break;
         }
         progress.report(0.5 + 0.45 * level as f32 / params.max_levels as f32, "refining")?;
         let first_new = surface.positions.len();
-        let (refined, level_stats) = refiner.refine(&surface, threads);
-        surface = refined;
+        let refined = refiner.refine(&surface, &marked, &greens, threads);
+        (surface, greens) = (refined.surface, refined.greens);
+        region = refined.from.iter().map(|&t| region[t as usize]).collect();
         let border = topology::border_vertices(&surface.triangles, surface.positions.len());
         relax::relax_level(&mut surface, first_new, &border, threads);
         mls::project_vertices(&mut surface, first_new, fit, mls_reach, threads);
         mls::unfold(&mut surface, &border, fit, mls_reach, threads);
-        stats.levels.push(level_stats);
+        stats.levels.push(refined.stats);
         crate::memory::release_freed();
         // Without a target distance only the final error is reported: no need to measure
         // each level (a hierarchy over all the triangles each time).
-        if params.target_distance > 0.0 {
-            (rms, max) = sample_error(&mut surface, measured, tree.diagonal, threads);
+        measured_now = target > 0.0;
+        if measured_now {
+            gap = gap_of(&mut surface);
         }
-        if rms <= params.target_distance {
+        let level = refined.stats;
+        if measured_now && gap.rms <= f64::from(target) {
             stats.stopped = RefinementStop::Target;
             break;
         }
-        if (level_stats.displaced as f64) < params.min_displaced * level_stats.new_vertices as f64 {
+        if (level.displaced as f64) < params.min_displaced * level.new_vertices as f64 {
             stats.stopped = RefinementStop::NoDetail;
             break;
         }
     }
-    if params.target_distance <= 0.0 && !stats.levels.is_empty() {
-        (rms, max) = sample_error(&mut surface, measured, tree.diagonal, threads);
+    if !measured_now {
+        gap = gap_of(&mut surface);
     }
-    (stats.final_error, stats.final_max_error) = (rms, max);
+    let d = f64::from(tree.diagonal).max(f64::MIN_POSITIVE);
+    (stats.final_error, stats.final_max_error) = (gap.rms / d, gap.max / d);
     Ok(surface)
 }
 
-/// error(M, S): RMS and max distance from `points` to the surface, over `diagonal`.
-fn sample_error(s: &mut refine::Surface, points: &[Vec3], diagonal: f32, threads: &Threads) -> (f64, f64) {
-    // The surface's arrays are lent to a mesh for the measure, not copied.
-    let mesh = Mesh::new(std::mem::take(&mut s.positions), None, std::mem::take(&mut s.triangles));
-    let distances: Vec<f64> = threads.run(|| {
-        let bvh = TriangleBvh::new(&mesh);
-        points.par_iter().map(|&p| f64::from(bvh.distance(p))).collect()
-    });
-    (s.positions, s.triangles) = (mesh.positions, mesh.triangles);
-    // Summed in order, so the figure is the same whatever the thread count.
-    let (sum_sq, max) = distances.iter().fold((0.0, 0.0f64), |(s, m), &d| (s + d * d, m.max(d)));
-    let d = f64::from(diagonal).max(f64::MIN_POSITIVE);
-    ((sum_sq / points.len().max(1) as f64).sqrt() / d, max / d)
+/// Marks every region that has more than half its `neighbours` (regions that share an edge)
+/// marked, until none is left: each boundary between refined and unrefined
+/// regions costs irregular vertices (a red-green transition), so a lone region left behind
+/// among refined ones is refined with them.
+fn fill_gaps(marked: &mut [bool], neighbours: &Rows) {
+    let mut count: Vec<usize> =
+        (0..marked.len()).map(|r| neighbours.of(r as u32).iter().filter(|&&n| marked[n as usize]).count()).collect();
+    let surrounded = |r: usize, count: usize| 2 * count > neighbours.of(r as u32).len();
+    let mut queue: Vec<usize> = (0..marked.len()).filter(|&r| !marked[r] && surrounded(r, count[r])).collect();
+    while let Some(r) = queue.pop() {
+        if marked[r] {
+            continue;
+        }
+        marked[r] = true;
+        for &n in neighbours.of(r as u32) {
+            let n = n as usize;
+            count[n] += 1;
+            if !marked[n] && surrounded(n, count[n]) {
+                queue.push(n);
+            }
+        }
+    }
+}
+
+/// How far a mesh is from the samples: error(M, S) unscaled, and per triangle.
+struct Gap {
+    /// RMS and largest distance from the measured points to the mesh, in their units.
+    rms: f64,
+    max: f64,
+    /// Per triangle: how many of the points are nearest to it, and their squared distances'
+    /// sum. Where each triangle's points are within a distance in the RMS, so are all points.
+    nearest: Vec<(u32, f32)>,
+}
+
+impl Gap {
+    /// The gap between `s` and `points`.
+    fn measure(s: &mut refine::Surface, points: &[Vec3], threads: &Threads) -> Gap {
+        // The surface's arrays are lent to a mesh for the measure, not copied.
+        let mesh = Mesh::new(std::mem::take(&mut s.positions), None, std::mem::take(&mut s.triangles));
+        let closest: Vec<Option<(u32, f32)>> = threads.run(|| {
+            let bvh = TriangleBvh::new(&mesh);
+            points.par_iter().map(|&p| bvh.closest_point(p).map(|c| (c.triangle, c.distance))).collect()
+        });
+        (s.positions, s.triangles) = (mesh.positions, mesh.triangles);
+        // Summed in order, so the figure is the same whatever the thread count.
+        let (mut sum_sq, mut max) = (0.0f64, 0.0f64);
+        let mut nearest = vec![(0u32, 0.0f32); s.triangles.len()];
+        for &(t, d) in closest.iter().flatten() {
+            (sum_sq, max) = (sum_sq + f64::from(d) * f64::from(d), max.max(f64::from(d)));
+            let n = &mut nearest[t as usize];
+            *n = (n.0 + 1, n.1 + d * d);
+        }
+        Gap { rms: (sum_sq / points.len().max(1) as f64).sqrt(), max, nearest }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_region_left_behind_among_refined_ones_is_refined_with_them() {
+        // Regions in a row 0-1-2-3-4, and 5 beside 1 and 3.
+        let pairs = [[0, 1], [1, 2], [2, 3], [3, 4], [5, 1], [5, 3]];
+        let rows = Rows::from_pairs(&pairs, 6);
+        // 1 has two of its three neighbours marked: it follows. 5 then has one of two, 3 one
+        // of three: they do not.
+        let mut marked = [true, false, true, false, false, false];
+        fill_gaps(&mut marked, &rows);
+        assert_eq!(marked, [true, true, true, false, false, false]);
+        // 2 and 5 each sit between 1 and 3; 0 and 4 have no other neighbour.
+        let mut marked = [false, true, false, true, false, false];
+        fill_gaps(&mut marked, &rows);
+        assert_eq!(marked, [true; 6]);
+        // One marked region among many stays alone.
+        let mut marked = [false, false, true, false, false, false];
+        fill_gaps(&mut marked, &rows);
+        assert_eq!(marked, [false, false, true, false, false, false]);
+    }
 }

@@ -11,7 +11,9 @@
 //!    polygonised over the tree's octree ([`dual_contour`], the default for a closed output)
 //!    or on a grid as fine as the deepest T-node ([`on_grid`]; an open output, and where the
 //!    octree's polygonisation is no 2-manifold) and clustered at the T-layer ([`cluster`]);
-//! 3. refinement ([`levels`]): split 1-to-4 on PN triangles and displace by the quadtrees
+//! 3. refinement ([`levels`]): split 1-to-4 on PN triangles (with a target distance, only the
+//!    regions of M0 whose samples are farther than it, with [`red_green`] transitions between
+//!    regions of different levels) and displace by the quadtrees
 //!    ([`refine`]); every vertex of M0 and of each level is then projected onto a local
 //!    quadratic fit of its nearest samples ([`mls`]; more of them the noisier the cloud), until
 //!    the mesh is close enough to the samples or the quadtrees have no detail left. M0 is
@@ -40,7 +42,9 @@ mod on_grid;
 mod outliers;
 mod params;
 mod prepare;
+mod red_green;
 mod refine;
+mod regions;
 mod relax;
 mod support;
 mod t_layer;

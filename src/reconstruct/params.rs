@@ -32,8 +32,10 @@ pub struct ReconstructParams {
     /// The tree: its L2 bound smooths noise (larger = smoother, fewer details); `d_a`/`d_d`
     /// set how deep the T-layer goes, i.e. how dense M0 is where curvature is high.
     pub tree: TreeParams,
-    /// Stop refining once error(M, S) (RMS distance over the diagonal) is at most this.
-    /// 0 = refine until the quadtrees have no detail left or `max_levels`.
+    /// Stop refining once error(M, S) (RMS distance over the diagonal) is at most this; each
+    /// level then splits only the regions of M0 whose samples are farther (in RMS) from their
+    /// triangles than this, so the triangles go where the detail is.
+    /// 0 = refine everywhere until the quadtrees have no detail left or `max_levels`.
     pub target_distance: f64,
     /// Most refinement levels (each multiplies the triangle count by 4). 0-12.
     pub max_levels: u32,

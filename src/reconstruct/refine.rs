@@ -1,5 +1,6 @@
-//! One refinement level (paper §5.2, "Mesh refinement"): every triangle is split 1-to-4; each
-//! new mid-edge vertex starts on the curved PN triangle of its edge (Vlachos et al. 2001), is
+//! One refinement level (paper §5.2, "Mesh refinement"): the triangles asked for (all of them,
+//! or those the samples are still far from) are split 1-to-4, their neighbours as a crack-free
+//! mesh needs ([`red_green`]); each new mid-edge vertex starts on the curved PN triangle of its edge (Vlachos et al. 2001), is
 //! then displaced by the quadtree of its T-node, and, where no quadtree leaf is left for it,
 //! smoothed tangentially towards its already final neighbours.
 //!
@@ -15,6 +16,7 @@
 use super::adjacency::Rows;
 use super::cluster::t_node_at;
 use super::leaf_fit::QuadraticPatch;
+use super::red_green::{self, Green};
 use crate::progress::Threads;
 use crate::quadric::CellStats;
 use crate::tree::{Node, NodeKind, VsTree};
@@ -34,8 +36,20 @@ pub(crate) struct Surface {
 /// What one level did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LevelStats {
+    /// Triangles split 1-to-4 (those marked, and those the crack-free closure added).
+    pub split: usize,
     pub new_vertices: usize,
     pub displaced: usize,
+}
+
+/// One refinement level's result.
+pub(crate) struct Level {
+    pub surface: Surface,
+    /// Its green pairs, merged back before the next level splits.
+    pub greens: Vec<Green>,
+    /// Per triangle: the triangle of the level before that it is part of.
+    pub from: Vec<u32>,
+    pub stats: LevelStats,
 }
 
 /// The quadtrees' leaves, summarised once, and which of them are used up.
@@ -91,22 +105,24 @@ impl<'t> Refiner<'t> {
         Refiner { tree, average, normal, variation, patch, locked }
     }
 
-    /// Splits every triangle of `s` 1-to-4 and places the new vertices.
-    pub fn refine(&self, s: &Surface, threads: &Threads) -> (Surface, LevelStats) {
-        threads.run(|| self.refine_level(s))
+    /// Splits the triangles of `s` that `marked` says 1-to-4 (and their neighbours as
+    /// [`red_green`] needs for a crack-free mesh, after merging `greens`, the previous
+    /// level's green pairs) and places the new vertices.
+    pub fn refine(&self, s: &Surface, marked: &[bool], greens: &[Green], threads: &Threads) -> Level {
+        threads.run(|| self.refine_level(s, marked, greens))
     }
 
-    fn refine_level(&self, s: &Surface) -> (Surface, LevelStats) {
+    fn refine_level(&self, s: &Surface, marked: &[bool], greens: &[Green]) -> Level {
         let old = s.positions.len() as u32;
-        let (edges, face_counts): (Vec<(u32, u32)>, Vec<u32>) =
-            crate::topology::edges_and_face_counts(&s.triangles).into_iter().unzip();
+        let halves_well = |t: [u32; 3], k: usize| halves_well(t.map(|v| s.positions[v as usize]), k);
+        let split = red_green::split(&s.triangles, s.positions.len(), marked, greens, halves_well);
         // A border edge (one face) gives a border vertex, which stays on its edge's curve:
         // sliding or smoothing it towards its neighbours would pull the border inward.
-        let on_border: Vec<bool> = face_counts.iter().map(|&faces| faces == 1).collect();
-        let mid = |a: u32, b: u32| old + edges.binary_search(&(a.min(b), a.max(b))).unwrap_or(0) as u32;
+        let on_border = &split.on_border;
 
         // New vertices on the PN triangles' edge curves, with PN's quadratic normals.
-        let placed: Vec<(Vec3, Vec3, u32)> = edges
+        let placed: Vec<(Vec3, Vec3, u32)> = split
+            .new_edges
             .par_iter()
             .map(|&(a, b)| {
                 let (pa, pb, na, nb) =
@@ -120,14 +136,7 @@ impl<'t> Refiner<'t> {
             positions: s.positions.clone(),
             normals: s.normals.clone(),
             labels: s.labels.clone(),
-            triangles: s
-                .triangles
-                .par_iter()
-                .flat_map_iter(|&[a, b, c]| {
-                    let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
-                    [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
-                })
-                .collect(),
+            triangles: split.triangles,
         };
         for (p, n, l) in &placed {
             out.positions.push(*p);
@@ -172,7 +181,8 @@ impl<'t> Refiner<'t> {
         smooth_tangentially(&mut out, old, &displaced, &border);
         self.project_undisplaced(&mut out, old as usize, &displaced);
         self.unfold(&mut out, old as usize, &border);
-        (out, LevelStats { new_vertices: placed.len(), displaced: moves.len() })
+        let stats = LevelStats { split: split.red, new_vertices: placed.len(), displaced: moves.len() };
+        Level { surface: out, greens: split.greens, from: split.from, stats }
     }
 
     /// Moves each vertex of the base mesh along the normal onto the tangent plane of the
@@ -494,6 +504,25 @@ pub(crate) fn pn_midpoint(pa: Vec3, na: Vec3, pb: Vec3, nb: Vec3) -> (Vec3, Vec3
     (p, if n == Vec3::ZERO { na } else { n })
 }
 
+/// A green split (see [`red_green`]) halves a triangle from the midpoint of one edge; where that
+/// makes an angle under this many degrees, and smaller than the triangle's own smallest, the
+/// triangle is split 1-to-4 instead, which keeps its shape: halving a skewed triangle (near a
+/// crease, where M0's triangles bend round) makes slivers.
+const GREEN_MIN_DEGREES: f32 = 20.0;
+
+/// Whether halving triangle `corners` at the midpoint of its edge `k` (corner k to k + 1)
+/// keeps its angles above [`GREEN_MIN_DEGREES`] or its own smallest.
+fn halves_well(corners: [Vec3; 3], k: usize) -> bool {
+    let smallest = |[a, b, c]: [Vec3; 3]| {
+        let at = |p: Vec3, q: Vec3, r: Vec3| (q - p).angle_between(r - p);
+        at(a, b, c).min(at(b, c, a)).min(at(c, a, b)).to_degrees()
+    };
+    let (b, c, a) = (corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3]);
+    let m = (b + c) / 2.0;
+    let halves = smallest([a, b, m]).min(smallest([a, m, c]));
+    halves >= GREEN_MIN_DEGREES.min(smallest(corners)) - 1e-3
+}
+
 /// Moves each new vertex that was not displaced towards the mean of its neighbours that are
 /// final (old vertices and displaced ones), within its tangent plane only. Each new vertex has
 /// at least its edge's two ends as final neighbours. Border vertices stay on their edge's curve.
@@ -545,6 +574,18 @@ mod tests {
             ..s
         };
         assert!(folded_or_creased_vertices(&flat, &pairs).is_empty());
+    }
+
+    #[test]
+    fn a_triangle_is_halved_only_where_that_makes_no_sliver() {
+        let h = 3f32.sqrt() / 2.0;
+        let equilateral = [Vec3::ZERO, Vec3::X, Vec3::new(0.5, h, 0.0)];
+        assert!((0..3).all(|k| halves_well(equilateral, k)), "halves of 30, 60 and 90 degrees");
+        // Right angle at the origin, 14 degrees at (4, 0). Halved across the hypotenuse, the
+        // smallest angle stays the triangle's own; across the long leg it would be 12.5.
+        let skewed = [Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::Y];
+        assert!(halves_well(skewed, 1));
+        assert!(!halves_well(skewed, 0));
     }
 
     #[test]
