@@ -11,7 +11,7 @@ use super::adjacency::Rows;
 use super::base_mesh::Base;
 use super::lookup::Lookup;
 use super::regions::{Regions, REGION_TRIANGLES};
-use super::{mls, refine, relax, ReconstructParams, ReconstructStats, RefinementStop};
+use super::{folds, mls, refine, relax, ReconstructParams, ReconstructStats, RefinementStop};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
@@ -88,7 +88,7 @@ pub(super) fn refine(
         let border = topology::border_vertices(&surface.triangles, surface.positions.len());
         relax::relax_level(&mut surface, first_new, &border, threads);
         mls::project_vertices(&mut surface, first_new, fit, mls_reach, threads);
-        mls::unfold(&mut surface, &border, fit, mls_reach, threads);
+        folds::unfold(&mut surface, &border, fit, mls_reach, threads);
         stats.levels.push(refined.stats);
         crate::memory::release_freed();
         // Without a target distance only the final error is reported: no need to measure

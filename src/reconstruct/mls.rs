@@ -8,9 +8,9 @@
 //! then a weighted quadratic height field over that plane, which removes the plane's sag on
 //! curved parts while still averaging the samples' noise.
 
-use super::adjacency::Rows;
+use super::folds::folded_vertices;
 use super::leaf_fit::solve;
-use super::refine::{folded_or_creased_vertices, folded_vertices, Surface};
+use super::refine::Surface;
 use crate::progress::Threads;
 use crate::spatial::{KdTree, Neighbour};
 use crate::tree::TreeSample;
@@ -362,57 +362,6 @@ pub(crate) fn project_vertices(s: &mut Surface, first: usize, onto: &SampleSurfa
     }
 }
 
-/// Rounds of [`unfold`]; from the second on the region grows by a ring each round.
-const UNFOLD_ROUNDS: usize = 4;
-
-/// Unfolds `s` where a triangle faces against its corners' normals or folds onto its neighbour
-/// ([`folded_or_creased_vertices`]: a displaced vertex slid over its neighbours, or two fits of
-/// a thin part disagree): each corner of such a triangle
-/// goes to the mean of its neighbours and back onto the samples' surface, in rounds. From the
-/// second round on, the ring around the vertices still folded moves too: a fold pinned by
-/// its own neighbours needs room. Vertices `border` marks stay.
-pub(crate) fn unfold(s: &mut Surface, border: &[bool], onto: &SampleSurface, reach: f32, threads: &Threads) {
-    // The triangles stay the same while their corners move: which faces meet is found once.
-    let pairs = threads.run(|| crate::topology::adjacent_face_pairs(&s.triangles));
-    let mut folded = threads.run(|| folded_or_creased_vertices(s, &pairs));
-    if folded.is_empty() {
-        return;
-    }
-    let neighbours = Rows::neighbours(&s.triangles, s.positions.len());
-    for round in 0..UNFOLD_ROUNDS {
-        if round > 0 {
-            let ring: Vec<usize> = folded.iter().flat_map(|&v| neighbours.of(v as u32)).map(|&w| w as usize).collect();
-            folded.extend(ring);
-            folded.sort_unstable();
-            folded.dedup();
-        }
-        let moved: Vec<(usize, Vec3, Vec3)> = threads.run(|| {
-            folded
-                .par_iter()
-                .filter(|&&v| !border[v] && !neighbours.of(v as u32).is_empty())
-                .map(|&v| {
-                    let ring = neighbours.of(v as u32);
-                    let mean = ring.iter().map(|&w| s.positions[w as usize]).sum::<Vec3>() / ring.len() as f32;
-                    let normal = ring.iter().map(|&w| s.normals[w as usize]).sum::<Vec3>().normalize_or_zero();
-                    let normal = if normal == Vec3::ZERO { s.normals[v] } else { normal };
-                    match onto.project(mean, normal) {
-                        Some((p, n)) if p.distance(mean) <= reach => (v, p, n),
-                        _ => (v, mean, normal),
-                    }
-                })
-                .collect()
-        });
-        for (v, p, n) in moved {
-            s.positions[v] = p;
-            s.normals[v] = n;
-        }
-        folded = threads.run(|| folded_or_creased_vertices(s, &pairs));
-        if folded.is_empty() {
-            return;
-        }
-    }
-}
-
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
@@ -493,63 +442,5 @@ pub(crate) mod tests {
         assert!((p.z - 0.01).abs() < 1e-5, "{p}");
         let (p, _) = surface.project(Vec3::new(0.013, 0.0, 0.002), -Vec3::Z).unwrap();
         assert!(p.z.abs() < 1e-5, "{p}");
-    }
-
-    /// An icosphere on sphere samples with three vertices slid along the sphere past their
-    /// whole ring, so triangles around them face inward; normals radial.
-    fn pushed_icosphere() -> Surface {
-        let sphere = crate::eval::shapes::icosphere(1.0, 3);
-        let mut s = Surface {
-            normals: sphere.positions.clone(),
-            labels: vec![0; sphere.positions.len()],
-            positions: sphere.positions.clone(),
-            triangles: sphere.triangles.clone(),
-        };
-        for v in [10, 200, 400] {
-            let p = s.positions[v];
-            let (u, _) = p.any_orthonormal_pair();
-            s.positions[v] = (p + 0.4 * u).normalize();
-        }
-        s
-    }
-
-    /// Unfolds `s` onto samples of the unit sphere; returns the largest distance of a vertex
-    /// from the sphere.
-    fn unfold_onto_the_sphere(s: &mut Surface) -> f32 {
-        let threads = Threads::new(1).unwrap();
-        let samples = sphere_samples(20_000, 1.0);
-        let onto = SampleSurface::new(&samples, &threads).unwrap();
-        let border = vec![false; s.positions.len()];
-        unfold(s, &border, &onto, 0.2, &threads);
-        s.positions.iter().map(|p| (p.length() - 1.0).abs()).fold(0.0f32, f32::max)
-    }
-
-    #[test]
-    fn a_vertex_pushed_over_its_neighbours_is_unfolded_back_onto_the_sphere() {
-        // Unfolding leaves no triangle folded and every vertex on the sphere.
-        let mut s = pushed_icosphere();
-        assert!(folded_vertices(&s).len() >= 9, "the push folds triangles");
-        let off = unfold_onto_the_sphere(&mut s);
-        assert!(folded_vertices(&s).is_empty(), "still folded: {:?}", folded_vertices(&s));
-        assert!(off < 1e-3, "a vertex {off} off the sphere");
-    }
-
-    #[test]
-    fn a_fold_whose_corner_normals_turned_with_it_is_unfolded_too() {
-        // As above, but every vertex's normal is its faces' mean, as a fit's normal turns with a
-        // fold: the corners' normals no longer tell the folded triangles, their dihedral angles do.
-        let mut s = pushed_icosphere();
-        let mut normals = vec![Vec3::ZERO; s.positions.len()];
-        for t in &s.triangles {
-            let [a, b, c] = t.map(|v| s.positions[v as usize]);
-            for &v in t {
-                normals[v as usize] += (b - a).cross(c - a);
-            }
-        }
-        s.normals = normals.into_iter().map(Vec3::normalize_or_zero).collect();
-        let off = unfold_onto_the_sphere(&mut s);
-        let left = folded_or_creased_vertices(&s, &crate::topology::adjacent_face_pairs(&s.triangles));
-        assert!(left.is_empty(), "still folded: {left:?}");
-        assert!(off < 1e-3, "a vertex {off} off the sphere");
     }
 }

@@ -18,7 +18,7 @@
 //!    quadratic fit of its nearest samples ([`mls`]; more of them the noisier the cloud), until
 //!    the mesh is close enough to the samples or the quadtrees have no detail left. M0 is
 //!    remeshed and each level's new vertices relaxed ([`relax`]), and folds are unfolded onto
-//!    the samples' fit ([`mls::unfold`]);
+//!    the samples' fit ([`folds::unfold`]);
 //! 4. where much of the closed surface has no sample supporting it (an open scan; see
 //!    [`Closure`]), only the supported part is kept ([`support`]), and faces past the scan's
 //!    border trimmed ([`trim`]).
@@ -32,6 +32,7 @@ mod base_mesh;
 mod cluster;
 mod dual_contour;
 mod field;
+mod folds;
 mod implicit;
 mod leaf_fit;
 mod levels;

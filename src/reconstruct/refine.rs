@@ -15,6 +15,7 @@
 
 use super::adjacency::Rows;
 use super::cluster::t_node_at;
+use super::folds::{folded_vertices, is_folded};
 use super::leaf_fit::QuadraticPatch;
 use super::red_green::{self, Green};
 use crate::progress::Threads;
@@ -453,40 +454,6 @@ const PATCH_TRUST: f32 = 0.5;
 /// Rounds of [`Refiner::unfold_base`].
 const UNFOLD_ROUNDS: usize = 5;
 
-/// Whether triangle `t` faces against the sum of its corners' normals.
-fn is_folded(s: &Surface, t: &[u32; 3]) -> bool {
-    let [a, b, c] = t.map(|v| s.positions[v as usize]);
-    let corners: Vec3 = t.iter().map(|&v| s.normals[v as usize]).sum();
-    (b - a).cross(c - a).dot(corners) < 0.0
-}
-
-/// Two faces sharing an edge are folded onto each other where their normals differ by more
-/// than this many degrees (the benchmark's fold): a surface sampled finer than its triangles
-/// rarely bends so sharply between two of them, so one of them most likely lies on the wrong side.
-const FOLD_DEGREES: f32 = 150.0;
-
-/// The corners of triangles whose normal points against the sum of their corners' normals.
-pub(crate) fn folded_vertices(s: &Surface) -> Vec<usize> {
-    let mut folded: Vec<usize> =
-        s.triangles.par_iter().filter(|t| is_folded(s, t)).flat_map_iter(|t| t.map(|v| v as usize)).collect();
-    folded.sort_unstable();
-    folded.dedup();
-    folded
-}
-
-/// [`folded_vertices`], and the corners of pairs of triangles folded onto each other across
-/// their edge (see [`FOLD_DEGREES`]; `pairs` from [`crate::topology::adjacent_face_pairs`]):
-/// where the corners' normals turned with their triangles, the first test alone misses the fold.
-pub(crate) fn folded_or_creased_vertices(s: &Surface, pairs: &[[u32; 2]]) -> Vec<usize> {
-    let mut folded = folded_vertices(s);
-    for pair in crate::topology::folded_face_pairs(&s.positions, &s.triangles, pairs, FOLD_DEGREES) {
-        folded.extend(pair.iter().flat_map(|&t| s.triangles[t as usize]).map(|v| v as usize));
-    }
-    folded.sort_unstable();
-    folded.dedup();
-    folded
-}
-
 /// The midpoint of a PN triangle's edge curve from (`pa`, `na`) to (`pb`, `nb`), and the PN
 /// quadratic normal there. The edge's cubic Bézier control points are the ends moved a third of
 /// the way along the edge and projected onto the end's tangent plane; the curve (and so the
@@ -552,29 +519,6 @@ fn smooth_tangentially(s: &mut Surface, first_new: u32, displaced: &[bool], bord
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_triangle_folded_back_onto_its_neighbour_is_found_whatever_its_corners_normals() {
-        // Two triangles across the edge (a, b), the second folded back over the first (their
-        // normals 179 degrees apart), each corner's normal turned with its own triangle: no
-        // triangle faces against its corners, yet the pair is a fold.
-        let s = Surface {
-            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(0.5, 1.0, 0.0), Vec3::new(0.5, 0.8, 0.01)],
-            normals: vec![Vec3::ZERO, Vec3::ZERO, Vec3::Z, -Vec3::Z],
-            labels: vec![0; 4],
-            triangles: vec![[0, 1, 2], [1, 0, 3]],
-        };
-        let pairs = crate::topology::adjacent_face_pairs(&s.triangles);
-        assert!(folded_vertices(&s).is_empty());
-        assert_eq!(folded_or_creased_vertices(&s, &pairs), vec![0, 1, 2, 3]);
-        // Opened out to a flat pair, it is no fold.
-        let flat = Surface {
-            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(0.5, 1.0, 0.0), Vec3::new(0.5, -1.0, 0.0)],
-            normals: vec![Vec3::Z; 4],
-            ..s
-        };
-        assert!(folded_or_creased_vertices(&flat, &pairs).is_empty());
-    }
 
     #[test]
     fn a_triangle_is_halved_only_where_that_makes_no_sliver() {
