@@ -8,6 +8,7 @@
 mod collapse;
 mod decimate;
 pub mod error;
+#[cfg(any(test, feature = "eval"))]
 pub mod eval;
 pub mod ffi;
 pub mod io;

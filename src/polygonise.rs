@@ -187,6 +187,7 @@ impl Grid {
 }
 
 /// Values, crossing edges and vertex numbers at every point of a grid, for [`polygonise_grid`].
+#[cfg(any(test, feature = "eval"))]
 struct Sampled {
     /// Points per axis.
     dims: [usize; 3],
@@ -199,6 +200,7 @@ struct Sampled {
     first_vertex: Vec<u32>,
 }
 
+#[cfg(any(test, feature = "eval"))]
 impl Sampled {
     fn point_index(&self, i: usize, j: usize, k: usize) -> usize {
         i + self.dims[0] * (j + self.dims[1] * k)
@@ -224,6 +226,7 @@ impl Sampled {
 ///
 /// Evaluation and triangulation run in parallel over z-slabs; the output is the same for any
 /// number of threads. A grid with fewer than 2 points along an axis gives an empty mesh.
+#[cfg(any(test, feature = "eval"))]
 pub(crate) fn polygonise_grid(f: impl Fn(Vec3) -> f32 + Sync, grid: &Grid) -> Mesh {
     if grid.dims.iter().any(|&d| d < 2) {
         return Mesh::default();
