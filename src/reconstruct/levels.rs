@@ -51,25 +51,33 @@ pub(super) fn refine(
     let target = (params.target_distance * f64::from(tree.diagonal)) as f32;
     stats.stopped = RefinementStop::MaxLevels;
     let mut greens = Vec::new();
-    // Per triangle: the region of M0 it is part of; a region refines as a whole.
-    let regions =
-        Regions::grow(surface.triangles.len(), &topology::adjacent_face_pairs(&surface.triangles), REGION_TRIANGLES);
-    let mut region = regions.of_triangle.clone();
+    // With a target: M0's regions, and per triangle the region it is part of (a region refines
+    // as a whole).
+    let mut regions = (target > 0.0).then(|| {
+        let grown = Regions::grow(
+            surface.triangles.len(),
+            &topology::adjacent_face_pairs(&surface.triangles),
+            REGION_TRIANGLES,
+        );
+        let of_triangle = grown.of_triangle.clone();
+        (grown, of_triangle)
+    });
     let mut measured_now = true;
     for level in 0..params.max_levels {
         if measured_now && gap.rms <= f64::from(target) {
             stats.stopped = RefinementStop::Target;
             break;
         }
-        let marked = if target > 0.0 {
-            let mut region_far = vec![false; regions.count()];
-            for (t, &(count, sum_sq)) in gap.nearest.iter().enumerate() {
-                region_far[region[t] as usize] |= count > 0 && sum_sq > target * target * count as f32;
+        let marked = match &regions {
+            Some((regions, region)) => {
+                let mut region_far = vec![false; regions.count()];
+                for (t, &(count, sum_sq)) in gap.nearest.iter().enumerate() {
+                    region_far[region[t] as usize] |= count > 0 && sum_sq > target * target * count as f32;
+                }
+                fill_gaps(&mut region_far, &regions.neighbours);
+                region.iter().map(|&r| region_far[r as usize]).collect()
             }
-            fill_gaps(&mut region_far, &regions.neighbours);
-            region.iter().map(|&r| region_far[r as usize]).collect()
-        } else {
-            vec![true; surface.triangles.len()]
+            None => vec![true; surface.triangles.len()],
         };
         let to_split = marked.iter().filter(|&&far| far).count();
         if to_split == 0 {
@@ -84,7 +92,9 @@ pub(super) fn refine(
         let first_new = surface.positions.len();
         let refined = refiner.refine(&surface, &marked, &greens, threads);
         (surface, greens) = (refined.surface, refined.greens);
-        region = refined.from.iter().map(|&t| region[t as usize]).collect();
+        if let Some((_, region)) = &mut regions {
+            *region = refined.from.iter().map(|&t| region[t as usize]).collect();
+        }
         let border = topology::border_vertices(&surface.triangles, surface.positions.len());
         relax::relax_level(&mut surface, first_new, &border, threads);
         mls::project_vertices(&mut surface, first_new, fit, mls_reach, threads);

@@ -7,6 +7,8 @@
 //! slivers) and neighbours differ by at most one level. A triangle next to a marked one across
 //! half of its hanging edge is split red first, so that no edge ever holds two midpoints.
 
+use rayon::prelude::*;
+
 /// A green pair: `parent` = (a, b, c) halved at `mid`, the midpoint of (b, c), into the
 /// triangles (a, b, mid) and (a, mid, c) at `faces` of the split mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,24 +75,31 @@ pub(crate) fn split(
         }
     }
 
-    // Edges: (key, face) sorted, one run per edge; a face's edges by index into the runs.
+    // Edges: (key, 3 * face + k for the face's edge k) sorted, one run per edge; each face's
+    // three edges as indices of their runs.
     let mut by_edge: Vec<(u64, u32)> = faces
-        .iter()
+        .par_iter()
         .enumerate()
-        .flat_map(|(f, face)| {
+        .flat_map_iter(|(f, face)| {
             let c = face.corners;
-            (0..3).map(move |k| (key(c[k], c[(k + 1) % 3]), f as u32))
+            (0..3).map(move |k| (key(c[k], c[(k + 1) % 3]), (3 * f + k) as u32))
         })
         .collect();
-    by_edge.sort_unstable();
-    let mut edge_keys: Vec<u64> = by_edge.iter().map(|e| e.0).collect();
-    edge_keys.dedup();
+    by_edge.par_sort_unstable();
+    let mut run_start: Vec<u32> = Vec::with_capacity(by_edge.len() / 2 + 1);
+    let mut face_edges = vec![[0u32; 3]; faces.len()];
+    for (i, &(k, slot)) in by_edge.iter().enumerate() {
+        if i == 0 || by_edge[i - 1].0 != k {
+            run_start.push(i as u32);
+        }
+        face_edges[slot as usize / 3][slot as usize % 3] = run_start.len() as u32 - 1;
+    }
+    run_start.push(by_edge.len() as u32);
+    let edge_keys: Vec<u64> = run_start[..run_start.len() - 1].iter().map(|&i| by_edge[i as usize].0).collect();
+    // Any edge of the mesh, by its ends (each face's own are in `face_edges`).
     let edge_of = |a: u32, b: u32| edge_keys.binary_search(&key(a, b)).expect("an edge of the mesh");
-    let faces_of = |e: usize| {
-        let k = edge_keys[e];
-        let start = by_edge.partition_point(|x| x.0 < k);
-        by_edge[start..].iter().take_while(move |x| x.0 == k).map(|x| x.1 as usize)
-    };
+    let faces_of =
+        |e: usize| by_edge[run_start[e] as usize..run_start[e + 1] as usize].iter().map(|x| x.1 as usize / 3);
     // Halves of hanging edges: (key, the face whose edge they halve).
     let mut halves: Vec<(u64, u32)> = Vec::new();
     let mut mid_of_edge: Vec<u32> = vec![u32::MAX; edge_keys.len()];
@@ -100,7 +109,7 @@ pub(crate) fn split(
             let (b, c) = (face.corners[k], face.corners[(k + 1) % 3]);
             halves.push((key(b, m), f as u32));
             halves.push((key(m, c), f as u32));
-            mid_of_edge[edge_of(b, c)] = m;
+            mid_of_edge[face_edges[f][k] as usize] = m;
             split_edges[f] = 1;
         }
     }
@@ -118,15 +127,14 @@ pub(crate) fn split(
         let c = faces[f].corners;
         for k in 0..3 {
             let (a, b) = (c[k], c[(k + 1) % 3]);
-            let e = edge_of(a, b);
+            let e = face_edges[f][k] as usize;
             if !is_split[e] {
                 is_split[e] = true;
                 for g in faces_of(e) {
                     split_edges[g] += 1;
                     let halved_badly = || {
-                        let c = faces[g].corners;
-                        let k = (0..3).find(|&k| key(c[k], c[(k + 1) % 3]) == key(a, b)).unwrap_or(0);
-                        !halves_well(c, k)
+                        let k = (0..3).find(|&k| face_edges[g][k] as usize == e).unwrap_or(0);
+                        !halves_well(faces[g].corners, k)
                     };
                     if !red[g] && (split_edges[g] >= 2 || halved_badly()) {
                         red[g] = true;
@@ -154,16 +162,14 @@ pub(crate) fn split(
             on_border.push(faces_of(e).count() == 1 && coarser_across(k).next().is_none());
         }
     }
-    let mid = |a: u32, b: u32| {
-        let e = edge_of(a, b);
-        is_split[e].then_some(mid_of_edge[e])
-    };
+    let mid_of = |e: usize| is_split[e].then_some(mid_of_edge[e]);
+    let mid = |a: u32, b: u32| mid_of(edge_of(a, b));
 
     let mut out = Split { new_edges, on_border, red: red.iter().filter(|&&r| r).count(), ..Split::default() };
     for (f, face) in faces.iter().enumerate() {
         let c = face.corners;
         if red[f] {
-            let m = [0, 1, 2].map(|k| mid(c[k], c[(k + 1) % 3]).expect("a red face's edges are split"));
+            let m = face_edges[f].map(|e| mid_of(e as usize).expect("a red face's edges are split"));
             out.triangles.push([m[0], m[1], m[2]]);
             for k in 0..3 {
                 // The corner child at corner k: (c[k], m[k], m[k - 1]). Where its outer edge is
@@ -179,7 +185,7 @@ pub(crate) fn split(
                     None => out.triangles.push(child),
                 }
             }
-        } else if let Some((k, m)) = (0..3).find_map(|k| mid(c[k], c[(k + 1) % 3]).map(|m| (k, m))) {
+        } else if let Some((k, m)) = (0..3).find_map(|k| mid_of(face_edges[f][k] as usize).map(|m| (k, m))) {
             push_green(&mut out, c, k, m);
         } else {
             out.triangles.push(c);
