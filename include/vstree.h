@@ -71,7 +71,7 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 7
+#define VSTREE_VERSION_MINOR 8
 
 /**
  * Patch version (semver).
@@ -377,13 +377,13 @@ enum vstree_keep_topology
 #endif // __cplusplus
  {
   /**
-   * Keep it when the input is a closed 2-manifold (no border, no non-manifold edge or
-   * vertex, consistently oriented); plain clustering otherwise. The default.
+   * Keep it when no edge of the input has more than two triangles (closed or with
+   * borders, as most scans are); plain clustering on non-manifold input. The default.
    */
   VSTREE_KEEP_TOPOLOGY_AUTO = 0,
   /**
    * Clusters merge by edge collapses under the link condition: a closed 2-manifold stays
-   * closed and manifold with its genus, an open one keeps its borders manifold. A cluster
+   * closed and manifold with its genus, an open one keeps its borders manifold and its holes. A cluster
    * that cannot merge without changing the topology keeps a vertex per piece.
    */
   VSTREE_KEEP_TOPOLOGY_ON = 1,

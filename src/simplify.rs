@@ -10,7 +10,7 @@ use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
 use crate::quadric::CellStats;
 use crate::samples::{MeshSampling, SampleSet};
-use crate::topology::analyze;
+use crate::topology::is_edge_manifold;
 use crate::tree::{self, Metric, NodeKind, TreeParams, TreeStats, VsTree};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -19,8 +19,9 @@ use std::time::Instant;
 /// Whether [`simplify`] keeps the input's topology.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum KeepTopology {
-    /// On when the input is a closed 2-manifold (watertight: no border, no non-manifold edge
-    /// or vertex, consistently oriented), off otherwise.
+    /// On when no edge of the input has more than two triangles (closed or with borders, as
+    /// most scans are; [`crate::topology::is_edge_manifold`]), off on non-manifold input, where
+    /// sheets already meet and plain clustering's speed costs nothing.
     #[default]
     Auto,
     /// Clusters are merged by edge collapses under the link condition ([`crate::collapse`]),
@@ -40,7 +41,7 @@ pub struct SimplifyParams {
     pub sampling: MeshSampling,
     /// Worker threads; 0 = all cores.
     pub threads: usize,
-    /// Whether the topology is kept; by default when the input is a closed 2-manifold.
+    /// Whether the topology is kept; by default when the input is edge-manifold.
     pub keep_topology: KeepTopology,
     /// Triangles wanted, from 1 to the input's count; 0 = as many as the error bound gives.
     /// With a target, `tree.error` is ignored (not even checked): the tree, built at a coarse
@@ -200,7 +201,7 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
         && match params.keep_topology {
             KeepTopology::On => true,
             KeepTopology::Off => false,
-            KeepTopology::Auto => analyze(mesh).is_watertight(),
+            KeepTopology::Auto => threads.run(|| is_edge_manifold(mesh)),
         };
     if params.target_faces > 0 {
         // Plain clustering stays plain: its output has non-manifold edges where sheets fused,

@@ -112,6 +112,31 @@ fn sorted_half_edges(faces: &[[u32; 3]]) -> Vec<HalfEdge> {
     half_edges
 }
 
+/// Whether no edge of `mesh` has more than two faces (degenerate and invalid faces aside): a
+/// closed surface or one with borders, as most scans are, whose topology edge collapses can
+/// keep. One parallel sort of the edges, none of [`analyze`]'s other passes.
+pub fn is_edge_manifold(mesh: &Mesh) -> bool {
+    let n = mesh.positions.len();
+    sorted_edge_keys(&mesh.triangles, |t| is_valid_face(t, n)).par_windows(3).all(|w| w[0] != w[2])
+}
+
+/// The edges of the `triangles` that `keep` takes, one key (low index in the high 32 bits) per
+/// face that has it, sorted.
+fn sorted_edge_keys(triangles: &[[u32; 3]], keep: impl Fn(&[u32; 3]) -> bool + Sync) -> Vec<u64> {
+    let mut keys: Vec<u64> = triangles
+        .par_iter()
+        .filter(|t| keep(t))
+        .flat_map_iter(|t| {
+            (0..3).map(move |k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                u64::from(a.min(b)) << 32 | u64::from(a.max(b))
+            })
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys
+}
+
 /// The components of a mesh that is known to be a closed 2-manifold (as the polygoniser makes
 /// it), and the genus summed over them: components − χ/2, in one pass and without the checks
 /// of [`analyze`]. For any other mesh the figures mean nothing.
@@ -279,17 +304,10 @@ fn is_single_fan(v: u32, fan: &[u32], faces: &[[u32; 3]]) -> bool {
 /// Every edge of `triangles` once, as (low, high) vertex index, in sorted order, with the number
 /// of faces that have it (1 on a border, 2 inside a manifold).
 pub fn edges_and_face_counts(triangles: &[[u32; 3]]) -> Vec<((u32, u32), u32)> {
-    let mut keys: Vec<u64> = triangles
-        .par_iter()
-        .flat_map_iter(|t| {
-            (0..3).map(move |k| {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                u64::from(a.min(b)) << 32 | u64::from(a.max(b))
-            })
-        })
-        .collect();
-    keys.par_sort_unstable();
-    keys.chunk_by(|a, b| a == b).map(|run| (((run[0] >> 32) as u32, run[0] as u32), run.len() as u32)).collect()
+    sorted_edge_keys(triangles, |_| true)
+        .chunk_by(|a, b| a == b)
+        .map(|run| (((run[0] >> 32) as u32, run[0] as u32), run.len() as u32))
+        .collect()
 }
 
 /// Which of `vertex_count` vertices lie on an edge that only one of `triangles` has.
@@ -408,6 +426,21 @@ mod tests {
     /// A unit tetrahedron with outward winding.
     fn tetrahedron() -> Mesh {
         Mesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z], None, vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    }
+
+    #[test]
+    fn edge_manifold_means_no_edge_with_three_faces() {
+        let mut m = tetrahedron();
+        assert!(is_edge_manifold(&m));
+        // Open, flipped, or with degenerate and out-of-range faces: still no edge with three.
+        m.triangles.pop();
+        m.triangles[0].swap(1, 2);
+        m.triangles.extend([[0, 0, 1], [0, 1, 99]]);
+        assert!(is_edge_manifold(&m));
+        // A fin on edge 0-1: three faces there.
+        m.positions.push(Vec3::NEG_ONE);
+        m.triangles.extend([[0, 1, 3], [1, 0, 4]]);
+        assert!(!is_edge_manifold(&m));
     }
 
     #[test]

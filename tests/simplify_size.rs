@@ -3,6 +3,7 @@
 
 mod common;
 
+use glam::Vec3;
 use vstree::topology::{analyze, TopologyReport};
 use vstree::{eval::shapes, simplify, KeepTopology, Mesh, Progress, SimplifyParams, SimplifyStats};
 
@@ -81,14 +82,69 @@ fn an_open_sheet_keeps_its_border_manifold_at_a_count() {
         assert!(r.boundary_edges > 0, "at {target}: the border closed");
         assert!(close_enough(out.triangles.len(), target), "{} for {target}", out.triangles.len());
     }
-    // Auto leaves an open input to plain clustering.
-    assert!(!to_size(&open, 500, KeepTopology::Auto).1.kept_topology);
 }
 
-/// Every shared and corpus mesh at 2% and 0.5% of its triangles: the count, and for closed
-/// manifold inputs (the default keeps their topology) watertightness, genus, components and
-/// zero non-manifold edges; where the topology needs more triangles than asked, the smallest
-/// closed mesh. Skipped without ../shared/data.
+/// The loops of border edges (edges with one face): a hole or an outer border each.
+fn border_loops(mesh: &Mesh) -> usize {
+    let mut parent: Vec<usize> = (0..mesh.positions.len()).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
+    }
+    let mut on_border = vec![false; mesh.positions.len()];
+    for ((a, b), faces) in vstree::topology::edges_and_face_counts(&mesh.triangles) {
+        if faces == 1 {
+            let (ra, rb) = (root(&mut parent, a as usize), root(&mut parent, b as usize));
+            parent[ra] = rb;
+            on_border[a as usize] = true;
+            on_border[b as usize] = true;
+        }
+    }
+    (0..parent.len()).filter(|&v| on_border[v] && root(&mut parent, v) == v).count()
+}
+
+#[test]
+fn scans_with_holes_keep_them_by_default_and_non_manifold_input_is_clustered_plainly() {
+    // A sphere with three holes, as a scan has where the scanner saw nothing: edge-manifold,
+    // so the default keeps its topology; each hole spans a few hundred input triangles, far
+    // more than the smallest targets' clusters.
+    let sphere = shapes::icosphere(1.0, 5);
+    let holes = [Vec3::X, Vec3::Y, -Vec3::Z];
+    let near_a_hole = |t: &[u32; 3]| {
+        let c = t.iter().map(|&v| sphere.positions[v as usize]).sum::<Vec3>() / 3.0;
+        holes.iter().any(|h| c.distance(*h) < 0.25)
+    };
+    let holey = Mesh::new(
+        sphere.positions.clone(),
+        None,
+        sphere.triangles.iter().filter(|t| !near_a_hole(t)).copied().collect(),
+    );
+    assert_eq!(border_loops(&holey), 3);
+    for target in [2000, 500, 100] {
+        let (out, stats) = to_size(&holey, target, KeepTopology::Auto);
+        let r = analyze(&out);
+        assert!(stats.kept_topology, "at {target}: an edge-manifold input, topology not kept by default");
+        assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.components), (0, 0, 1), "at {target}: {r:?}");
+        assert_eq!(border_loops(&out), 3, "at {target}: a hole closed or split");
+        assert!(close_enough(out.triangles.len(), target), "{} for {target}", out.triangles.len());
+    }
+    // A fin on one of the sphere's edges: three faces there, non-manifold, plain clustering.
+    let [a, b, _] = sphere.triangles[0];
+    let mut positions = sphere.positions.clone();
+    positions.push(0.75 * (positions[a as usize] + positions[b as usize]));
+    let mut triangles = sphere.triangles.clone();
+    triangles.push([a, b, positions.len() as u32 - 1]);
+    let finned = Mesh::new(positions, None, triangles);
+    assert!(!to_size(&finned, 500, KeepTopology::Auto).1.kept_topology);
+}
+
+/// Every shared and corpus mesh at 2% and 0.5% of its triangles: the count; for edge-manifold
+/// inputs (the default keeps their topology) zero non-manifold edges, the components and the
+/// border loops kept, and for closed ones watertightness and genus; where the topology needs
+/// more triangles than asked, the smallest mesh. Skipped without ../shared/data.
 #[test]
 fn real_models_reach_two_and_a_half_percent() {
     let mut closed = 0;
@@ -110,8 +166,13 @@ fn real_models_reach_two_and_a_half_percent() {
                 r.genus(),
                 r.non_manifold_edges
             );
+            if input.non_manifold_edges == 0 {
+                assert!(stats.kept_topology, "{name}: edge-manifold, topology not kept by default");
+                assert_eq!(r.non_manifold_edges, 0, "{name} at {percent}%");
+                assert_eq!(r.components, input.components, "{name} at {percent}%");
+                assert_eq!(border_loops(&out), border_loops(&mesh), "{name} at {percent}%: holes");
+            }
             if input.is_watertight() {
-                assert!(stats.kept_topology, "{name}");
                 assert!(r.is_watertight() && r.non_manifold_edges == 0, "{name} at {percent}%: {r:?}");
                 assert_eq!((r.genus(), r.components), (input.genus(), input.components), "{name} at {percent}%");
                 let reachable = target.max(floor(&input));

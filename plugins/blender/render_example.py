@@ -1,4 +1,4 @@
-"""Renders the picture in the README's Blender section, headless, with the extension itself:
+"""Renders the picture in plugins/blender/README.md, headless, with the extension itself:
 installs the extension zip, imports a point cloud with Blender's PLY importer, runs
 "Reconstruct surface", and renders the result with Cycles on the CPU.
 

@@ -213,9 +213,10 @@ void addSizeParams(RichParameterList& pl, const vstree_simplify_params& d)
 		"If non zero, the wanted size as a fraction of the input's faces (0.1 keeps 10%); it "
 		"overrides the target number of faces."));
 	pl.addParam(RichEnum("keep_topology", d.keep_topology, kKeepTopology, "Keep topology",
-		"Auto: for closed 2-manifold inputs, clusters merge by edge collapses that keep the mesh "
-		"closed and manifold with its genus; other inputs get plain clustering. On: keep the "
-		"topology of any input (open borders stay manifold). Off: plain vertex clustering, faster, "
+		"Auto: for edge-manifold inputs (no edge in more than two faces: closed, or with borders as "
+		"scans have), clusters merge by edge collapses that keep the genus, the borders manifold "
+		"and the holes open; non-manifold inputs get plain clustering. On: keep the topology of "
+		"any input. Off: plain vertex clustering, faster, "
 		"which may fuse close sheets into non-manifold edges."));
 }
 

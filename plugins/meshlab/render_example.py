@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Makes the picture in the README's MeshLab section: the plugin's VS-Tree simplification of a
+"""Makes the picture in plugins/meshlab/README.md: the plugin's VS-Tree simplification of a
 mesh, run through pymeshlab, saved as ASCII PLY, then drawn by docs/render.py.
 
 Usage (in the venv build.sh made, e.g. target/meshlab/2025.7.post1/venv):

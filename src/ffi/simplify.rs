@@ -56,11 +56,11 @@ c_enum!(vstree_sampling { Vertices = "VSTREE_SAMPLING_VERTICES", FaceCenters = "
 #[repr(i32)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum vstree_keep_topology {
-    /// Keep it when the input is a closed 2-manifold (no border, no non-manifold edge or
-    /// vertex, consistently oriented); plain clustering otherwise. The default.
+    /// Keep it when no edge of the input has more than two triangles (closed or with
+    /// borders, as most scans are); plain clustering on non-manifold input. The default.
     Auto = 0,
     /// Clusters merge by edge collapses under the link condition: a closed 2-manifold stays
-    /// closed and manifold with its genus, an open one keeps its borders manifold. A cluster
+    /// closed and manifold with its genus, an open one keeps its borders manifold and its holes. A cluster
     /// that cannot merge without changing the topology keeps a vertex per piece.
     On = 1,
     /// Plain vertex clustering (the paper's): faster, but it may fuse sheets and make

@@ -1,4 +1,5 @@
 use super::*;
+use crate::topology::analyze;
 
 #[test]
 fn clusters_asked_for_a_target_and_after_a_short_round() {

@@ -573,8 +573,8 @@ def simplify(mesh, progress=None, ratio=None, **params):
     16; not used with a size), ``tree_kind`` ("vstree" | "octree"), ``metric``
     ("l2" | "l21" | "density"), ``sampling`` ("vertices" | "faces"), ``d_a``, ``d_d``,
     ``max_depth``, ``threads`` (0 = all cores), ``min_cell_size``, ``keep_topology``
-    ("auto": kept for closed 2-manifolds, the default; "on" or True; "off" or False: plain
-    clustering), ``target_faces`` (triangles wanted instead of the bound; 0 = the bound).
+    ("auto", the default: kept when no edge has more than two triangles, closed or with
+    borders as scans have; "on" or True; "off" or False: plain clustering), ``target_faces`` (triangles wanted instead of the bound; 0 = the bound).
 
     ``ratio`` (in (0, 1]) asks for that fraction of the input's triangles instead of
     ``target_faces`` (rounded, at least 1). Below what the topology allows, the result is the

@@ -84,8 +84,8 @@ CLOSURES = [
 ]
 
 KEEP_TOPOLOGY = [
-    ('auto', "Auto", "Keep it when the mesh is closed and manifold; plain clustering otherwise"),
-    ('on', "On", "Merge clusters only by collapses that keep the topology (borders stay manifold)"),
+    ('auto', "Auto", "Keep it when no edge has more than two faces (closed, or with borders as scans have); plain clustering otherwise"),
+    ('on', "On", "Merge clusters only by collapses that keep the topology (borders stay manifold, holes open)"),
     ('off', "Off", "Plain vertex clustering: faster, may fuse close sheets"),
 ]
 

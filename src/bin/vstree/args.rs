@@ -25,8 +25,9 @@ pub(crate) enum Command {
     /// Every leaf of the tree becomes one output vertex, placed where it best fits the samples'
     /// tangent planes; triangles are re-indexed, and those that collapse are dropped. A point
     /// cloud without normals gets them estimated first. The size is set by the error bound
-    /// (--error), or exactly by --faces or --ratio. A closed 2-manifold input keeps its
-    /// topology unless --no-keep-topology is given.
+    /// (--error), or exactly by --faces or --ratio. An edge-manifold input (no edge in
+    /// more than two triangles: closed or with borders, as most scans are) keeps its topology
+    /// unless --no-keep-topology is given.
     ///
     /// A run that would keep nothing of the shape is an error naming the flag that made the tree
     /// that coarse (--error, --max-depth or --min-cell-size): a mesh whose every triangle
@@ -55,13 +56,13 @@ pub(crate) enum Command {
         #[arg(long, allow_hyphen_values = true, conflicts_with = "error")]
         ratio: Option<f64>,
         /// Keep the topology: clusters merge by edge collapses that keep a closed 2-manifold
-        /// closed and manifold with its genus (and an open one's borders manifold); a cluster
-        /// that cannot merge without changing the topology keeps a vertex per piece, so the
-        /// output may have more vertices than clusters. The default for closed 2-manifold
-        /// inputs; this flag asks for it on any input.
+        /// closed and manifold with its genus (and an open one's borders manifold, its holes
+        /// open); a cluster that cannot merge without changing the topology keeps a vertex per
+        /// piece, so the output may have more vertices than clusters. The default for
+        /// edge-manifold inputs; this flag asks for it on any input.
         #[arg(long, conflicts_with = "no_keep_topology")]
         keep_topology: bool,
-        /// Plain vertex clustering even for a closed 2-manifold input: faster, but sheets
+        /// Plain vertex clustering even for an edge-manifold input: faster, but sheets
         /// closer than a cluster may fuse, with non-manifold edges and another genus.
         #[arg(long)]
         no_keep_topology: bool,
