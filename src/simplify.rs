@@ -218,7 +218,7 @@ pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -
     } else {
         let labels = vertex_labels(mesh, &samples, &clusters, params.sampling, &tree);
         if keep {
-            collapse_keeping_topology(mesh, &labels, &clusters.representatives).0
+            collapse_keeping_topology(mesh, &labels, &clusters.representatives, &threads).0
         } else {
             collapse(mesh, &labels, &clusters.representatives, &threads)?.0
         }
@@ -397,7 +397,7 @@ fn simplify_to_size(
         round += 1;
         progress.report(0.7, "clustering")?;
         let out = if keep {
-            collapse_keeping_topology(mesh, &labels, &clusters.representatives)
+            collapse_keeping_topology(mesh, &labels, &clusters.representatives, threads)
         } else {
             collapse(mesh, &labels, &clusters.representatives, threads)?
         };
@@ -478,10 +478,16 @@ pub fn vertex_labels(
 }
 
 /// Merges each cluster's vertices by edge collapses that keep the topology (see
-/// [`SimplifyParams::keep_topology`]). A cluster left with one vertex puts it at the cluster's
+/// [`SimplifyParams::keep_topology`]): inside chunks of clusters in parallel
+/// ([`chunks::collapse_inside_chunks`]), then serially along the chunks' seams. A cluster left with one vertex puts it at the cluster's
 /// representative; a cluster kept in pieces leaves each at the mean of what it absorbed.
 /// Returns the mesh and the cluster of each of its vertices.
-fn collapse_keeping_topology(mesh: &Mesh, labels: &[u32], representatives: &[Vec3]) -> (Mesh, Vec<u32>) {
+fn collapse_keeping_topology(
+    mesh: &Mesh,
+    labels: &[u32],
+    representatives: &[Vec3],
+    threads: &Threads,
+) -> (Mesh, Vec<u32>) {
     // Degenerate triangles, and those with a vertex in no cluster, take no part.
     let proper: Vec<[u32; 3]> = mesh
         .triangles
@@ -489,16 +495,27 @@ fn collapse_keeping_topology(mesh: &Mesh, labels: &[u32], representatives: &[Vec
         .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2] && t.iter().all(|&v| labels[v as usize] != NO_CLUSTER))
         .copied()
         .collect();
-    let mut used = vec![false; mesh.positions.len()];
-    for &v in proper.iter().flatten() {
-        used[v as usize] = true;
-    }
-    let mut collapser = Collapser::new(&Mesh::new(mesh.positions.clone(), None, proper));
-    for (v, _) in used.iter().enumerate().filter(|(_, &used)| !used) {
-        collapser.remove_vertex(v);
-    }
-    collapser.collapse_within(labels);
-    let (mut out, out_labels) = collapser.finish(labels);
+    let proper = Mesh::new(mesh.positions.clone(), None, proper);
+    let (mut out, out_labels) = match threads.run(|| chunks::collapse_inside_chunks(&proper, labels, representatives)) {
+        // The seams and borders the chunks left.
+        Some((rest, rest_labels)) => {
+            let mut collapser = Collapser::new(&rest);
+            collapser.collapse_within(&rest_labels);
+            collapser.finish(&rest_labels)
+        }
+        None => {
+            let mut used = vec![false; mesh.positions.len()];
+            for &v in proper.triangles.iter().flatten() {
+                used[v as usize] = true;
+            }
+            let mut collapser = Collapser::new(&proper);
+            for (v, _) in used.iter().enumerate().filter(|(_, &used)| !used) {
+                collapser.remove_vertex(v);
+            }
+            collapser.collapse_within(labels);
+            collapser.finish(labels)
+        }
+    };
     let mut pieces = vec![0u32; representatives.len()];
     for &label in &out_labels {
         pieces[label as usize] += 1;
@@ -563,5 +580,6 @@ fn collapse(mesh: &Mesh, labels: &[u32], representatives: &[Vec3], threads: &Thr
     Ok((Mesh::new(positions, None, triangles), clusters))
 }
 
+mod chunks;
 #[cfg(test)]
 mod tests;

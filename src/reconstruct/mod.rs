@@ -133,7 +133,7 @@ fn evenly_spread<T: Copy>(points: &[T], n: usize) -> Vec<T> {
 
 /// Renumbers the vertices that `triangles` use 0, 1, ... in the order they first appear, and
 /// returns the old index of each new one (vertices no triangle uses are left out).
-pub(super) fn renumber_used_vertices(triangles: &mut [[u32; 3]], vertices: usize) -> Vec<usize> {
+pub(crate) fn renumber_used_vertices(triangles: &mut [[u32; 3]], vertices: usize) -> Vec<usize> {
     let mut index = vec![u32::MAX; vertices];
     let mut kept = Vec::new();
     for v in triangles.iter_mut().flatten() {

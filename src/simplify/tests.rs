@@ -69,7 +69,7 @@ fn one_round_suffices_on_closed_shapes() {
         tree::fit(&mut tree, clusters_for(target, None, 1.0), &threads);
         let clusters = cluster(&tree, &threads);
         let labels = vertex_labels(&mesh, &samples, &clusters, MeshSampling::Vertices, &tree);
-        let (kept, _) = collapse_keeping_topology(&mesh, &labels, &clusters.representatives);
+        let (kept, _) = collapse_keeping_topology(&mesh, &labels, &clusters.representatives, &Threads::new(0).unwrap());
         let (plain, _) = collapse(&mesh, &labels, &clusters.representatives, &threads).unwrap();
         for out in [kept, plain] {
             let n = out.triangles.len();
