@@ -29,7 +29,7 @@ namespace {
 const QStringList kTreeKinds{"VS-Tree", "Octree"};
 const QStringList kMetrics{"L2 (quadric)", "L2,1 (normal deviation)", "Density (samples)"};
 const QStringList kSamplings{"Vertices", "Face centers"};
-const QStringList kKeepTopology{"Auto (closed manifolds)", "On", "Off"};
+const QStringList kKeepTopology{"Auto (edge-manifold inputs)", "On", "Off"};
 const QStringList kLabelKinds{"Cluster", "T-node"};
 // Indexed by the VSTREE_CLOSURE_* values.
 const QStringList kClosures{"Auto (open scans stay open)", "Closed", "Open"};

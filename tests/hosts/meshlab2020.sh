@@ -154,7 +154,7 @@ mlx_simplify() { # mlx_simplify OUT PERC: the simplification to PERC of the face
  <filter name="VS-Tree Clustering Simplification">
   <Param type="RichInt" value="0" name="target_faces"/>
   <Param type="RichFloat" value="$2" name="target_perc"/>
-  <Param type="RichEnum" value="0" name="keep_topology" enum_cardinality="3" enum_val0="Auto (closed manifolds)" enum_val1="On" enum_val2="Off"/>
+  <Param type="RichEnum" value="0" name="keep_topology" enum_cardinality="3" enum_val0="Auto (edge-manifold inputs)" enum_val1="On" enum_val2="Off"/>
   <Param type="RichFloat" value="0.001" name="error"/>
   <Param type="RichAbsPerc" value="0" min="0" max="1" name="distance"/>
   <Param type="RichEnum" value="0" name="tree_kind" enum_cardinality="2" enum_val0="VS-Tree" enum_val1="Octree"/>
