@@ -12,11 +12,13 @@
 //!
 //! ```text
 //! cargo bench --bench simplify -- [--ratios 0.02,0.005] [--runs N] [--models a,b]
-//!     [--data ../shared/data] [--curve igea,camel] [--curve-ratios ...] [--peers a,b] [--no-write]
+//!     [--data ../shared/data] [--curve igea,camel] [--curve-ratios ...] [--peers a,b]
+//!     [--large 3.5M,14M,50M] [--no-write]
 //! ```
 
 #[path = "../common/mod.rs"]
 mod common;
+mod large;
 mod report;
 
 use common::cli::{list, names, number, shown};
@@ -43,6 +45,9 @@ usage: cargo bench --bench simplify -- [options]
   --threads N         vstree's worker threads, 0 = all cores (default 0)
   --peers A,B         only these peers (default all: meshopt-simplify, meshopt-sloppy,
                       fast-simplification, meshlab-qec, meshlab-clustering; or none)
+  --large A,B         also generated meshes of these sizes (3.5M, 14M, 50M: corpus meshes split
+                      1-to-4 with a little noise, kept under target/bench-simplify/large/;
+                      --models naming none of the data's skips those)
   --no-write          print the report only: do not update docs/benchmarks.md or the plots";
 
 /// The peers `benches/peers.py` runs, in the order the table shows them.
@@ -70,6 +75,7 @@ struct Options {
     curve_ratios: Vec<f64>,
     threads: usize,
     peers: Vec<String>,
+    large: Vec<String>,
     write: bool,
 }
 
@@ -84,6 +90,7 @@ impl Options {
             curve_ratios: vec![0.0025, 0.005, 0.01, 0.02, 0.05, 0.1],
             threads: 0,
             peers: PEERS.iter().map(|p| p.to_string()).collect(),
+            large: Vec::new(),
             write: true,
         };
         let mut it = args.iter();
@@ -107,6 +114,7 @@ impl Options {
                         return Err(format!("unknown peer {p}\n{USAGE}"));
                     }
                 }
+                "--large" => o.large = names(value()?),
                 "--no-write" => o.write = false,
                 other => return Err(format!("unknown option {other}\n{USAGE}")),
             }
@@ -171,13 +179,18 @@ fn inputs(data: &Path, only: Option<&[String]>) -> Vec<Input> {
                     continue;
                 }
             };
-            let Ok(samples) = SampleSet::from_mesh(&mesh, MeshSampling::Vertices) else { continue };
-            let diagonal = vstree::Aabb::of(&samples.positions).map_or(1.0, |b| b.diagonal());
-            let genus = analyze(&mesh).genus();
-            inputs.push(Input { name, path, mesh, points: samples.positions, diagonal, genus });
+            inputs.extend(input(name, path, mesh));
         }
     }
     inputs
+}
+
+/// `mesh`, read from `path`, as an input: `None` if it has no triangle to sample.
+fn input(name: String, path: PathBuf, mesh: Mesh) -> Option<Input> {
+    let samples = SampleSet::from_mesh(&mesh, MeshSampling::Vertices).ok()?;
+    let diagonal = vstree::Aabb::of(&samples.positions).map_or(1.0, |b| b.diagonal());
+    let genus = analyze(&mesh).genus();
+    Some(Input { name, path, mesh, points: samples.positions, diagonal, genus })
 }
 
 /// The triangle count for `ratio` of `input`'s.
@@ -241,11 +254,16 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     let mut rows = Vec::new();
     let mut curve = Vec::new();
     let mut notes = Vec::new();
-    let inputs = inputs(&o.data, o.models.as_deref());
+    let out_dir = root.join("target").join("bench-simplify");
+    let mut inputs = inputs(&o.data, o.models.as_deref());
+    for size in &o.large {
+        eprintln!("simplify: the {size} input (generated on first use)");
+        let (name, path, mesh) = large::mesh(size, &o.data, &out_dir.join("large"))?;
+        inputs.extend(input(name, path, mesh));
+    }
     if inputs.is_empty() {
         return Err(format!("no triangle mesh in {}", shown(&o.data, root)));
     }
-    let out_dir = root.join("target").join("bench-simplify");
     for input in &inputs {
         let on_curve = o.curve.contains(&input.name);
         let mut ratios = o.ratios.clone();
