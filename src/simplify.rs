@@ -479,8 +479,9 @@ pub fn vertex_labels(
 
 /// Merges each cluster's vertices by edge collapses that keep the topology (see
 /// [`SimplifyParams::keep_topology`]): inside chunks of clusters in parallel
-/// ([`chunks::collapse_inside_chunks`]), then serially along the chunks' seams. A cluster left with one vertex puts it at the cluster's
-/// representative; a cluster kept in pieces leaves each at the mean of what it absorbed.
+/// ([`chunks::collapse_inside_chunks`]), then serially along the chunks' seams. A cluster left
+/// with one vertex puts it at the cluster's representative; a cluster kept in pieces leaves each
+/// at the mean of what it absorbed.
 /// Returns the mesh and the cluster of each of its vertices.
 fn collapse_keeping_topology(
     mesh: &Mesh,

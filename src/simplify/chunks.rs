@@ -1,6 +1,6 @@
-//! The first, parallel pass of the topology-keeping merge: the clusters are cut into chunks of
-//! consecutive labels (the tree's leaves in depth-first order, so each chunk is one region of
-//! space), and each chunk's collapses run on its own, on its own threads. A collapse there takes
+//! The first, parallel pass of the topology-keeping merge: the clusters, in Morton order of
+//! their representatives, are cut into chunks (each one region of space), and each chunk's
+//! collapses run on its own, on its own threads. A collapse there takes
 //! only an edge between two vertices of one cluster whose whole star lies in the chunk and off
 //! any border: the link condition (`Collapser::can_collapse`) reads nothing but the two stars,
 //! so it decides as it would on the whole mesh. What is left (the vertices along the chunks'
