@@ -71,7 +71,7 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 8
+#define VSTREE_VERSION_MINOR 9
 
 /**
  * Patch version (semver).
@@ -1376,6 +1376,28 @@ vstree_status vstree_simplify(const struct vstree_mesh *mesh,
                               vstree_progress_fn progress,
                               void *user_data,
                               struct vstree_simplify_result **out_result);
+
+/**
+ * Simplifies the PLY file at `path` (NUL-terminated) to `params->target_faces` triangles
+ * without holding it in memory, for meshes larger than memory: the file is read three times,
+ * front to back, a few MiB at a time; memory follows the output's size, plus 4 bytes per input
+ * vertex. The tree is built from a sample of the triangles (face centres, whatever
+ * `params->sampling` says), and the clustering is plain: the topology is not kept (sheets
+ * closer than a cluster may fuse), so `params->keep_topology` must be VSTREE_KEEP_TOPOLOGY_AUTO
+ * or VSTREE_KEEP_TOPOLOGY_OFF. The result is as from vstree_simplify(); save its mesh with
+ * vstree_mesh_save(). Since 0.9.0.
+ *
+ * Fails as vstree_simplify() does and as vstree_mesh_load() does on the file, and with
+ * VSTREE_STATUS_INVALID_PARAMETER for no target (`target_faces` 0), a target above the
+ * file's triangles or VSTREE_KEEP_TOPOLOGY_ON, VSTREE_STATUS_INVALID_INPUT for a file that is
+ * not PLY or whose faces come before its vertices, and VSTREE_STATUS_TOO_LARGE when the
+ * memory it needs is not there. Thread-safe.
+ */
+vstree_status vstree_simplify_ply_file(const char *path,
+                                       const struct vstree_simplify_params *params,
+                                       vstree_progress_fn progress,
+                                       void *user_data,
+                                       struct vstree_simplify_result **out_result);
 
 /**
  * The simplified mesh, owned by `result`: valid until vstree_simplify_result_free(result),

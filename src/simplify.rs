@@ -407,15 +407,7 @@ fn simplify_to_size(
         want = clusters_for(target, Some((leaves, out.0.triangles.len())), factor);
     };
     progress.report(0.9, "collapsing edges to the size")?;
-    let origin = tree.root().center.as_dvec3();
-    let quadrics = out_clusters.iter().map(|&c| cluster_stats[c as usize]).collect();
-    let mut out = if out.triangles.len() > target + 1 { decimate(&out, quadrics, origin, target).0 } else { out };
-    out.origin = mesh.origin;
-    if out.triangles.is_empty() {
-        return Err(Error::input(format!(
-            "every triangle collapsed for a target of {target}: the model has only degenerate or repeated triangles at this size"
-        )));
-    }
+    let out = collapse_to_target(out, &out_clusters, &cluster_stats, &tree, target, mesh.origin)?;
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
         tree: tree.stats(),
@@ -429,6 +421,29 @@ fn simplify_to_size(
         kept_topology: keep,
     };
     Ok((out, stats))
+}
+
+/// Brings the clustered mesh `out` (vertex v from cluster `out_clusters[v]`, whose sums are
+/// in `stats`, relative to `tree`'s root centre) to `target` triangles by quadric collapses,
+/// and puts it at `origin`; refused when nothing is left.
+fn collapse_to_target(
+    out: Mesh,
+    out_clusters: &[u32],
+    stats: &[CellStats],
+    tree: &VsTree,
+    target: usize,
+    origin: DVec3,
+) -> Result<Mesh> {
+    let quadrics = out_clusters.iter().map(|&c| stats[c as usize]).collect();
+    let centre = tree.root().center.as_dvec3();
+    let mut out = if out.triangles.len() > target + 1 { decimate(&out, quadrics, centre, target).0 } else { out };
+    out.origin = origin;
+    if out.triangles.is_empty() {
+        return Err(Error::input(format!(
+            "every triangle collapsed for a target of {target}: the model has only degenerate or repeated triangles at this size"
+        )));
+    }
+    Ok(out)
 }
 
 /// The cluster of every mesh vertex ([`NO_CLUSTER`] for vertices no triangle uses). With face
@@ -582,5 +597,7 @@ fn collapse(mesh: &Mesh, labels: &[u32], representatives: &[Vec3], threads: &Thr
 }
 
 mod chunks;
+mod stream;
+pub use stream::simplify_ply_streaming;
 #[cfg(test)]
 mod tests;

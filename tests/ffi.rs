@@ -334,3 +334,34 @@ fn random_bad_input_gives_statuses_never_panics() {
     }
     assert!(ok > 20, "only {ok} valid runs");
 }
+
+#[test]
+fn a_ply_file_simplified_through_the_abi_equals_the_rust_call() {
+    let scratch = common::scratch::Scratch::new("ffi-stream");
+    let path = scratch.0.join("torus.ply");
+    vstree::io::write(&path, &shapes::torus(1.0, 0.3, 120, 60)).unwrap();
+    let c_path = CString::new(path.to_str().unwrap()).unwrap();
+    let mut p = vstree_simplify_params_default();
+    p.target_faces = 1000;
+    let mut result = null_mut();
+    let status = unsafe { vstree_simplify_ply_file(c_path.as_ptr(), &p, None, null_mut(), &mut result) };
+    assert_eq!(status, vstree_status::Ok, "{}", last_error());
+    let out = read_back(unsafe { vstree_simplify_result_get_mesh(result) });
+    let stats = unsafe { *vstree_simplify_result_get_stats(result) };
+    unsafe { vstree_simplify_result_free(result) };
+    let params = SimplifyParams { target_faces: 1000, ..Default::default() };
+    let (expected, _) = vstree::simplify::simplify_ply_streaming(&path, &params, &mut Progress::none()).unwrap();
+    assert_eq!(out, expected);
+    assert_eq!((stats.input_triangles, stats.output_triangles, stats.kept_topology), (14_400, 1000, 0));
+    // What a stream refuses, and null pointers, are statuses with a message; nothing is written.
+    p.keep_topology = 1;
+    let mut result = null_mut();
+    let status = unsafe { vstree_simplify_ply_file(c_path.as_ptr(), &p, None, null_mut(), &mut result) };
+    assert_eq!(status, vstree_status::InvalidParameter);
+    assert!(last_error().contains("keeping the topology needs the whole mesh"), "{}", last_error());
+    assert!(result.is_null());
+    let status = unsafe { vstree_simplify_ply_file(null(), &p, None, null_mut(), &mut result) };
+    assert_eq!(status, vstree_status::NullPointer);
+    let status = unsafe { vstree_simplify_ply_file(c_path.as_ptr(), &p, None, null_mut(), null_mut()) };
+    assert_eq!(status, vstree_status::NullPointer);
+}

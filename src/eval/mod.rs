@@ -5,9 +5,11 @@
 //!   implicit surfaces), sampling points on a surface, and noise.
 //! - [`distance`]: point-to-mesh and mesh-to-mesh distances, Chamfer and Hausdorff.
 //! - [`figures`]: valences, enclosed volume and area.
+//! - [`written`]: large generated meshes written straight to a file.
 //!
 //! Counts, watertightness and genus are [`crate::topology`]'s: the product uses them too.
 
 pub mod distance;
 pub mod figures;
 pub mod shapes;
+pub mod written;

@@ -162,7 +162,7 @@ unsafe fn create<T>(
 }
 
 /// A path from a C string: any bytes on Unix, UTF-8 elsewhere.
-unsafe fn path_arg(path: *const c_char, argument: &str) -> FfiResult<PathBuf> {
+pub(crate) unsafe fn path_arg(path: *const c_char, argument: &str) -> FfiResult<PathBuf> {
     let pointer = non_null(path, argument)?;
     // SAFETY: non-NULL; the caller gives a NUL-terminated string.
     let bytes = unsafe { CStr::from_ptr(pointer) }.to_bytes();

@@ -1,14 +1,15 @@
 //! Clustering simplification: the parameter struct (shared with vstree_tree_build(), which
 //! builds the same tree), the call, and its result handle with the output mesh and statistics.
 
-use super::mesh::{mesh_ref, vstree_mesh};
+use super::mesh::{mesh_ref, path_arg, vstree_mesh};
 use super::params::{self, c_enum, enum_field, threads, Versioned};
 use super::progress::{vstree_progress_fn, with_progress};
 use super::{guard, handle, non_null, vstree_status, write_out, FfiResult};
+use crate::mesh::Mesh;
 use crate::samples::MeshSampling;
-use crate::simplify::{simplify, KeepTopology, SimplifyParams};
+use crate::simplify::{simplify, simplify_ply_streaming, KeepTopology, SimplifyParams, SimplifyStats};
 use crate::tree::{Metric, TreeKind, TreeParams, TreeStats};
-use std::ffi::c_void;
+use std::ffi::{c_char, c_void};
 use std::time::Instant;
 
 /// Which hierarchy to build (the `tree_kind` field).
@@ -292,32 +293,71 @@ pub unsafe extern "C" fn vstree_simplify(
         let mesh = unsafe { mesh_ref(mesh, "mesh") }?;
         let params = unsafe { read_params(params) }?;
         let (out, s) = with_progress(progress, user_data, |p| simplify(mesh, &params, p))?;
-        let [samples, nodes, v_nodes, t_nodes, s_nodes, clusters] = tree_figures(&s.tree);
-        let stats = vstree_simplify_stats {
-            struct_size: std::mem::size_of::<vstree_simplify_stats>() as u32,
-            max_depth: s.tree.max_depth,
-            t_depth_min: s.tree.t_depth_min,
-            t_depth_max: s.tree.t_depth_max,
-            input_vertices: s.input_vertices as u64,
-            input_triangles: s.input_triangles as u64,
-            output_vertices: s.output_vertices as u64,
-            output_triangles: s.output_triangles as u64,
-            samples,
-            nodes,
-            v_nodes,
-            t_nodes,
-            s_nodes,
-            clusters,
-            cluster_size_mean: s.tree.leaf_size_mean,
-            cluster_size_variance: s.tree.leaf_size_variance,
-            seconds_samples: s.seconds_samples,
-            seconds_tree: s.seconds_tree,
-            seconds_cluster: s.seconds_cluster,
-            seconds_total: start.elapsed().as_secs_f64(),
-            kept_topology: u32::from(s.kept_topology),
-            target_faces: params.target_faces as u32,
-        };
-        let result = vstree_simplify_result { mesh: vstree_mesh { mesh: out }, stats };
+        let result = simplify_result(out, &s, &params, start);
+        unsafe { write_out(out_result, handle::into_raw(result)) };
+        Ok(())
+    })
+}
+
+/// The result handle of a simplification that started at `start`.
+fn simplify_result(out: Mesh, s: &SimplifyStats, params: &SimplifyParams, start: Instant) -> vstree_simplify_result {
+    let [samples, nodes, v_nodes, t_nodes, s_nodes, clusters] = tree_figures(&s.tree);
+    let stats = vstree_simplify_stats {
+        struct_size: std::mem::size_of::<vstree_simplify_stats>() as u32,
+        max_depth: s.tree.max_depth,
+        t_depth_min: s.tree.t_depth_min,
+        t_depth_max: s.tree.t_depth_max,
+        input_vertices: s.input_vertices as u64,
+        input_triangles: s.input_triangles as u64,
+        output_vertices: s.output_vertices as u64,
+        output_triangles: s.output_triangles as u64,
+        samples,
+        nodes,
+        v_nodes,
+        t_nodes,
+        s_nodes,
+        clusters,
+        cluster_size_mean: s.tree.leaf_size_mean,
+        cluster_size_variance: s.tree.leaf_size_variance,
+        seconds_samples: s.seconds_samples,
+        seconds_tree: s.seconds_tree,
+        seconds_cluster: s.seconds_cluster,
+        seconds_total: start.elapsed().as_secs_f64(),
+        kept_topology: u32::from(s.kept_topology),
+        target_faces: params.target_faces as u32,
+    };
+    vstree_simplify_result { mesh: vstree_mesh { mesh: out }, stats }
+}
+
+/// Simplifies the PLY file at `path` (NUL-terminated) to `params->target_faces` triangles
+/// without holding it in memory, for meshes larger than memory: the file is read three times,
+/// front to back, a few MiB at a time; memory follows the output's size, plus 4 bytes per input
+/// vertex. The tree is built from a sample of the triangles (face centres, whatever
+/// `params->sampling` says), and the clustering is plain: the topology is not kept (sheets
+/// closer than a cluster may fuse), so `params->keep_topology` must be VSTREE_KEEP_TOPOLOGY_AUTO
+/// or VSTREE_KEEP_TOPOLOGY_OFF. The result is as from vstree_simplify(); save its mesh with
+/// vstree_mesh_save(). Since 0.9.0.
+///
+/// Fails as vstree_simplify() does and as vstree_mesh_load() does on the file, and with
+/// VSTREE_STATUS_INVALID_PARAMETER for no target (`target_faces` 0), a target above the
+/// file's triangles or VSTREE_KEEP_TOPOLOGY_ON, VSTREE_STATUS_INVALID_INPUT for a file that is
+/// not PLY or whose faces come before its vertices, and VSTREE_STATUS_TOO_LARGE when the
+/// memory it needs is not there. Thread-safe.
+#[no_mangle]
+pub unsafe extern "C" fn vstree_simplify_ply_file(
+    path: *const c_char,
+    params: *const vstree_simplify_params,
+    progress: vstree_progress_fn,
+    user_data: *mut c_void,
+    out_result: *mut *mut vstree_simplify_result,
+) -> vstree_status {
+    guard("vstree_simplify_ply_file", || {
+        let start = Instant::now();
+        non_null(out_result, "out_result")?;
+        let path = unsafe { path_arg(path, "path") }?;
+        let params = unsafe { read_params(params) }?;
+        let (out, s) = with_progress(progress, user_data, |p| simplify_ply_streaming(&path, &params, p))?;
+        let result = simplify_result(out, &s, &params, start);
         unsafe { write_out(out_result, handle::into_raw(result)) };
         Ok(())
     })

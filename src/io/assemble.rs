@@ -87,6 +87,11 @@ fn origin_for(points: &[DVec3]) -> DVec3 {
         return DVec3::ZERO;
     };
     let (min, max) = points.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    origin_for_box(min, max)
+}
+
+/// The origin [`mesh`] stores points in the box `min..=max` relative to.
+pub(crate) fn origin_for_box(min: DVec3, max: DVec3) -> DVec3 {
     let extent = (max - min).max_element();
     let largest = min.abs().max(max.abs()).max_element();
     if largest <= FAR_FROM_ORIGIN * extent {

@@ -20,6 +20,10 @@ pub(crate) const PREFIX_BYTES: usize = 64 * 1024;
 /// last byte a reader asked for.
 const CHUNK: usize = 64 * 1024;
 
+/// A streaming input drops the bytes a reader has released once they are this many (1 MiB): a
+/// copy of what is left to the front of the buffer costs little next to reading that much.
+const RELEASE_AT: usize = 1 << 20;
+
 /// The most bytes a line of an OFF, XYZ or ASCII PLY file may hold (16 MiB): its longest real
 /// line is a face, and a face of a million corners with 10-digit indices takes 11 MB, so a
 /// longer line is not one of these formats and reading stops there instead of holding it.
@@ -29,26 +33,44 @@ pub(crate) const MAX_LINE: usize = 16 << 20;
 /// for them; an error reading the file, or a file that grows meanwhile, is reported instead of
 /// what `read` returns.
 pub(crate) fn read<T>(path: &Path, read: impl FnOnce(&mut Input) -> Result<T>) -> Result<T> {
+    read_file(path, false, read)
+}
+
+/// [`read`] for a reader that goes through the file once, front to back, and calls
+/// [`Input::release`] as it goes: only the bytes from the last release on stay in memory, so
+/// a file larger than memory can be read.
+pub(crate) fn stream<T>(path: &Path, read: impl FnOnce(&mut Input) -> Result<T>) -> Result<T> {
+    read_file(path, true, read)
+}
+
+fn read_file<T>(path: &Path, streaming: bool, read: impl FnOnce(&mut Input) -> Result<T>) -> Result<T> {
     let io_error = |e| Error::io(path, e);
     let (file, size) = open_regular(path).map_err(io_error)?;
     let size = usize::try_from(size).map_err(|_| Error::TooLarge(format!("{}: {size} bytes", path.display())))?;
     // One byte more than the size, to notice a file that grows while it is read.
     let mut source = file.take(size as u64 + 1);
     let mut input = Input::reading(&mut source, size);
+    input.streaming = streaming;
     let result = read(&mut input);
     if let Some(e) = input.failed.take() {
         return Err(io_error(e));
     }
-    if input.data.len() > size {
+    if input.end() > size {
         return Err(io_error(io::Error::other("the file grew while it was read: read it once it is complete")));
     }
     result
 }
 
 /// The bytes of an input, in memory or pulled from a source as a reader asks for them.
-/// Positions are from the start of the input; what has been pulled stays in memory.
+/// Positions are from the start of the input; what has been pulled stays in memory, unless the
+/// input streams (see [`stream`]), where bytes before the last [`Input::release`] are dropped.
 pub(crate) struct Input<'a> {
+    /// The bytes from `base` on.
     data: Cow<'a, [u8]>,
+    base: usize,
+    /// Whether bytes before `released` may be dropped.
+    streaming: bool,
+    released: usize,
     /// Where more bytes come from; `None` once it has ended or failed, or for bytes in memory.
     source: Option<&'a mut dyn Read>,
     /// The input's whole size as far as it is known (a file's size when it was opened), which
@@ -61,63 +83,100 @@ pub(crate) struct Input<'a> {
 impl<'a> Input<'a> {
     /// An input whose bytes are all in memory.
     pub(crate) fn memory(bytes: &'a [u8]) -> Input<'a> {
-        Input { data: Cow::Borrowed(bytes), source: None, size: bytes.len(), failed: None }
+        Input {
+            data: Cow::Borrowed(bytes),
+            base: 0,
+            streaming: false,
+            released: 0,
+            source: None,
+            size: bytes.len(),
+            failed: None,
+        }
     }
 
     /// An input read from `source`, which holds about `size` bytes.
     pub(crate) fn reading(source: &'a mut dyn Read, size: usize) -> Input<'a> {
-        Input { data: Cow::Owned(Vec::new()), source: Some(source), size, failed: None }
+        Input {
+            data: Cow::Owned(Vec::new()),
+            base: 0,
+            streaming: false,
+            released: 0,
+            source: Some(source),
+            size,
+            failed: None,
+        }
     }
 
     /// The bytes from `start` on, at least `n` of them unless the input ends before.
     pub(crate) fn get(&mut self, start: usize, n: usize) -> &[u8] {
-        self.pull(start.saturating_add(n));
-        let data = &*self.data;
-        let end = start.saturating_add(n).min(data.len());
-        data.get(start..end).unwrap_or_default()
+        let end = start.saturating_add(n);
+        self.pull(end);
+        self.slice(start..end)
     }
 
     /// The bytes from `at` to the end of those pulled, pulling more if there are none; empty
     /// past the end of the input.
     #[inline]
     pub(crate) fn available(&mut self, at: usize) -> &[u8] {
-        if at >= self.data.len() {
+        if at >= self.end() {
             self.pull(at + 1);
         }
-        self.data.get(at..).unwrap_or_default()
+        self.slice(at..usize::MAX)
     }
 
     /// The byte at `at`, or `None` past the end of the input.
     #[inline]
     pub(crate) fn byte(&mut self, at: usize) -> Option<u8> {
-        if at >= self.data.len() {
+        if at >= self.end() {
             self.pull(at + 1);
         }
-        self.data.get(at).copied()
+        at.checked_sub(self.base).and_then(|i| self.data.get(i)).copied()
     }
 
-    /// The bytes pulled so far (all of them for an input in memory).
-    pub(crate) fn pulled(&self) -> &[u8] {
-        &self.data
+    /// The bytes of `range` that have been pulled (and, streaming, not released).
+    #[inline]
+    pub(crate) fn slice(&self, range: Range<usize>) -> &[u8] {
+        debug_assert!(range.start >= self.base, "byte {} was released", range.start);
+        let end = range.end.min(self.end());
+        self.data.get(range.start - self.base..end.saturating_sub(self.base)).unwrap_or_default()
+    }
+
+    /// Where the bytes pulled so far end.
+    #[inline]
+    pub(crate) fn end(&self) -> usize {
+        self.base + self.data.len()
+    }
+
+    /// Says that the reader will not look before byte `at` again: a streaming input drops those
+    /// bytes at its next pull once they are [`RELEASE_AT`] or more.
+    #[inline]
+    pub(crate) fn release(&mut self, at: usize) {
+        self.released = self.released.max(at);
     }
 
     /// Bytes from `at` to the end of the input as far as its size is known.
     pub(crate) fn remaining(&self, at: usize) -> usize {
-        self.size.max(self.data.len()).saturating_sub(at)
+        self.size.max(self.end()).saturating_sub(at)
     }
 
     /// Reads from the source until `end` bytes are in memory or the source ends, at least
     /// [`CHUNK`] bytes at a time.
     fn pull(&mut self, end: usize) {
-        let have = self.data.len();
-        let Some(source) = self.source.as_mut().filter(|_| end > have) else {
+        if self.source.is_none() || end <= self.end() {
             return;
-        };
-        let want = (end - have).max(CHUNK);
+        }
+        let releasable = self.released.min(self.end()).saturating_sub(self.base);
+        if self.streaming && releasable >= RELEASE_AT {
+            self.data.to_mut().drain(..releasable);
+            self.base += releasable;
+        }
+        let Some(source) = self.source.as_mut() else { return };
+        let have = self.data.len();
+        let want = (end - self.base - have).max(CHUNK);
         let bytes = self.data.to_mut();
         // Room grows geometrically (pulls are small), but never past the size of the input.
         if bytes.capacity() - have < want {
-            bytes.reserve_exact(want.max(have).min(self.size.saturating_sub(have) + 1));
+            bytes.reserve_exact(want.max(have).min(self.size.saturating_sub(self.base + have) + 1));
         }
         match source.take(want as u64).read_to_end(bytes) {
             Ok(got) if got == want => {}
@@ -207,7 +266,7 @@ impl Lines {
 
     /// The text of the line at `range` (from [`Lines::next_range`]), without a final `\r`.
     pub(crate) fn text<'i>(input: &'i Input, range: Range<usize>) -> Cow<'i, str> {
-        let line = input.pulled().get(range).unwrap_or_default();
+        let line = input.slice(range);
         String::from_utf8_lossy(line.strip_suffix(b"\r").unwrap_or(line))
     }
 }
@@ -327,6 +386,31 @@ mod tests {
         let mut bytes = Vec::new();
         ply::write(&mut bytes, mesh, ascii).unwrap();
         bytes
+    }
+
+    #[test]
+    fn a_streaming_input_holds_only_what_was_not_released() {
+        // 64 MiB read 3000 bytes at a time, each released once read: never more than the
+        // release threshold and one pull in memory; without streaming, everything stays.
+        let size = 64 << 20;
+        for streaming in [true, false] {
+            let mut source = io::repeat(7).take(size as u64);
+            let mut input = Input::reading(&mut source, size);
+            input.streaming = streaming;
+            let (mut at, mut most) = (0, 0);
+            while !input.get(at, 3000).is_empty() {
+                assert!(input.get(at, 3000).iter().all(|&b| b == 7));
+                at += input.get(at, 3000).len();
+                input.release(at);
+                most = most.max(input.data.len());
+            }
+            assert_eq!(at, size);
+            if streaming {
+                assert!(most <= RELEASE_AT + 2 * CHUNK, "{most} bytes held");
+            } else {
+                assert_eq!(most, size);
+            }
+        }
     }
 
     #[test]

@@ -54,7 +54,7 @@ def test_registered(addon):
     assert hasattr(bpy.types, "VSTREE_PT_panel")
     ok, msg = addon.core.status()
     assert ok, msg
-    assert "libvstree 0.8.0" in msg
+    assert "libvstree 0.9.0" in msg
 
 
 def test_defaults_are_the_librarys(addon):

@@ -110,6 +110,26 @@ def test_simplify_to_a_size_keeps_a_closed_torus_closed(shape):
     assert 14 <= out.triangle_count <= 60 and euler_genus(out) == (1, True)
 
 
+def test_a_ply_file_is_simplified_streaming_without_being_loaded(shape, tmp_path):
+    p, t, _ = shape
+    path = str(tmp_path / "torus.ply")
+    vstree.Mesh(p, t).save(path)
+    out, s = vstree.simplify_ply_file(path, target_faces=400)
+    assert abs(out.triangle_count - 400) <= 1 and s["kept_topology"] == 0
+    assert s["input_triangles"] == len(t) and s["target_faces"] == 400
+    stages = []
+    vstree.simplify_ply_file(path, target_faces=400, progress=lambda f, stage: stages.append(stage) or True)
+    assert "reading the faces" in stages and "clustering" in stages
+    with pytest.raises(vstree.VstreeError, match="keeping the topology needs the whole mesh"):
+        vstree.simplify_ply_file(path, target_faces=400, keep_topology="on")
+    with pytest.raises(vstree.VstreeError, match="needs a target size"):
+        vstree.simplify_ply_file(path)
+    with pytest.raises(vstree.VstreeError, match="No such file"):
+        vstree.simplify_ply_file(str(tmp_path / "missing.ply"), target_faces=10)
+    with pytest.raises(vstree.CancelledError):
+        vstree.simplify_ply_file(path, target_faces=400, progress=lambda f, stage: False)
+
+
 def test_point_clouds_with_normals_simplify_to_points(shape):
     p, _, n = shape
     result = vstree.simplify(vstree.Mesh(p, None, n), metric="density", error=16)

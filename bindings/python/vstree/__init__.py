@@ -45,6 +45,7 @@ __all__ = [
     "VstreeError",
     "CancelledError",
     "simplify",
+    "simplify_ply_file",
     "reconstruct",
     "estimate_normals",
     "load",
@@ -590,6 +591,25 @@ def simplify(mesh, progress=None, ratio=None, **params):
         cb = _Progress("vstree.simplify", progress)
         result = ctypes.c_void_p()
         cb.check(lib.vstree_simplify(handle, ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
+    return _simplify_result(result)
+
+
+def simplify_ply_file(path, progress=None, **params):
+    """Simplifies the PLY file at ``path`` to ``target_faces`` triangles without holding it in
+    memory, for meshes larger than memory: the file is read three times, a few MiB at a time,
+    and memory follows the output's size plus 4 bytes per input vertex. The clustering is plain
+    (the topology is not kept, sheets closer than a cluster may fuse), so ``keep_topology``
+    may only be "auto" or "off"; the tree is built from a sample of the triangles. Other
+    parameters as :func:`simplify`. Returns ``SimplifyResult(mesh, stats)``."""
+    p = _params("vstree.simplify_ply_file", params)
+    cb = _Progress("vstree.simplify_ply_file", progress)
+    result = ctypes.c_void_p()
+    cb.check(lib.vstree_simplify_ply_file(_path(path), ctypes.byref(p), cb.c_function, None, ctypes.byref(result)))
+    return _simplify_result(result)
+
+
+def _simplify_result(result):
+    """The mesh and statistics of a simplification's result handle, which is freed."""
     try:
         stats = lib.vstree_simplify_result_get_stats(result).contents
         if stats.struct_size < ctypes.sizeof(_ffi.SimplifyStats):

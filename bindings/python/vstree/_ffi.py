@@ -293,6 +293,10 @@ _SIGNATURES = {
         status_t,
         [c_void_p, POINTER(SimplifyParams), PROGRESS, c_void_p, POINTER(c_void_p)],
     ),
+    "vstree_simplify_ply_file": (
+        status_t,
+        [c_char_p, POINTER(SimplifyParams), PROGRESS, c_void_p, POINTER(c_void_p)],
+    ),
     "vstree_simplify_result_get_mesh": (c_void_p, [c_void_p]),
     "vstree_simplify_result_get_stats": (POINTER(SimplifyStats), [c_void_p]),
     "vstree_simplify_result_free": (None, [c_void_p]),

@@ -66,6 +66,15 @@ pub(crate) enum Command {
         /// closer than a cluster may fuse, with non-manifold edges and another genus.
         #[arg(long)]
         no_keep_topology: bool,
+        /// Read a PLY file in passes instead of holding it, for meshes larger than memory:
+        /// memory follows the output's size plus 4 bytes per input vertex. The file is read
+        /// three times; the tree is built from a sample of its triangles (face centres,
+        /// whatever --sampling says), and the clustering is plain: the topology is not kept
+        /// (sheets closer than a cluster may fuse). Needs --faces or --ratio (with --ratio,
+        /// the faces the header declares are counted). auto = when the file is larger than
+        /// an eighth of the memory available and the other conditions hold.
+        #[arg(long, value_enum, default_value_t = Stream::Auto)]
+        stream: Stream,
         /// Write PLY as text instead of binary.
         #[arg(long)]
         ascii: bool,
@@ -227,6 +236,14 @@ pub(crate) enum Sampling {
     Vertices,
     /// One sample per face, at its centre.
     Faces,
+}
+
+/// Whether `simplify` streams its input (see its `--stream`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub(crate) enum Stream {
+    Auto,
+    On,
+    Off,
 }
 
 impl From<Sampling> for MeshSampling {

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 use vstree::reconstruct::{reconstruct, BaseMesh, Closure, ReconstructParams};
-use vstree::simplify::{simplify, KeepTopology, SimplifyParams, SimplifyStats};
+use vstree::simplify::{simplify, simplify_ply_streaming, KeepTopology, SimplifyParams, SimplifyStats};
 use vstree::tree::{TreeKind, TreeParams};
 use vstree::{io, Progress, SampleSet, Threads};
 
@@ -71,6 +71,7 @@ mod console {
 mod args;
 mod demo;
 mod report;
+mod streamed;
 
 use args::{unsigned, BaseMeshArg, Cli, Command, SIMPLIFY_ERROR};
 use demo::demo;
@@ -124,6 +125,7 @@ fn message(e: &vstree::Error) -> String {
         "max_levels" => "--levels",
         "trim" => "--trim",
         "k" | "neighbours" => "--neighbours",
+        "stream" => "--stream",
         _ => return e.to_string(),
     };
     format!("{flag}: {message}")
@@ -176,19 +178,47 @@ fn read_with_normals(path: &Path, threads: usize, quiet: bool) -> vstree::Result
 
 fn run(command: Command) -> vstree::Result<()> {
     match command {
-        Command::Simplify { input, output, tree, sampling, faces, ratio, keep_topology, no_keep_topology, ascii } => {
+        Command::Simplify {
+            input,
+            output,
+            tree,
+            sampling,
+            faces,
+            ratio,
+            keep_topology,
+            no_keep_topology,
+            stream,
+            ascii,
+        } => {
             let tree_params = tree.params(SIMPLIFY_ERROR)?;
             tree_params.check()?; // before reading what may be a large file
             let threads = tree.threads()?;
             let size = Size::from_flags(faces, ratio)?;
             let target = reserve_output(&input, &output)?;
             say_threads(threads, tree.quiet);
-            let (mesh, read_s) = timed(|| read_with_normals(&input, threads, tree.quiet))?;
             let keep_topology = match (keep_topology, no_keep_topology) {
                 (true, _) => KeepTopology::On,
                 (_, true) => KeepTopology::Off,
                 _ => KeepTopology::Auto,
             };
+            if let Some(faces) = streamed::decide(stream, &input, &size, keep_topology, tree.quiet)? {
+                let params = SimplifyParams {
+                    tree: tree_params,
+                    sampling: sampling.into(),
+                    threads,
+                    keep_topology,
+                    target_faces: size.faces(faces)?,
+                };
+                let (out, stats) =
+                    with_progress(tree.quiet, |progress| simplify_ply_streaming(&input, &params, progress))?;
+                let (_, write_s) = timed(|| target.write(&out, &io::WriteOptions { ascii }))?;
+                if !tree.quiet {
+                    print_simplify(&input, &output, &stats, 0.0, write_s)?;
+                }
+                say_size_missed(params.target_faces, &stats);
+                return Ok(());
+            }
+            let (mesh, read_s) = timed(|| read_with_normals(&input, threads, tree.quiet))?;
             let params = SimplifyParams {
                 tree: tree_params,
                 sampling: sampling.into(),

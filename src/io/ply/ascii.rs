@@ -9,30 +9,32 @@
 //! is not read on, and so is a line longer than [`MAX_LINE`], which no real file holds.
 
 use super::header::Header;
-use super::items::{self, Cursor, Fail, Parts};
-use super::plan::Plan;
+use super::items::{self, Cursor, Fail, Sink};
+use super::plan::{Plan, Target};
 use super::scalar::Scalar;
 use crate::error::Result;
 use crate::io::input::{self, Input, MAX_LINE};
 use crate::io::text;
-use crate::mesh::Mesh;
 use std::path::Path;
 
-/// Reads the body that starts at byte `start` of `input`, on line `first_line`.
+/// Reads the body that starts at byte `start` of `input`, on line `first_line`, into `sink`.
 pub(crate) fn read(
     input: &mut Input,
     start: usize,
     first_line: usize,
     header: &Header,
     plan: &Plan,
+    sink: &mut impl Sink,
     path: &Path,
-) -> Result<Mesh> {
+) -> Result<()> {
     let mut tokens = Tokens { input, pos: start, line: first_line, line_start: start, item_line: first_line, found: 0 };
-    let mut parts = Parts::new(plan.vertex_count, plan.has_normals);
     for (element, job) in header.elements.iter().zip(&plan.jobs) {
-        items::read_element(&mut tokens, element, job, &mut parts, path)?;
+        if job.target == Target::Faces && !sink.wants_faces() {
+            break;
+        }
+        items::read_element(&mut tokens, element, job, plan.vertex_count, sink, path)?;
     }
-    Ok(parts.into_mesh())
+    Ok(())
 }
 
 /// Whether a byte may be in a token: it is neither whitespace nor a byte that no text holds.
@@ -109,7 +111,7 @@ impl Tokens<'_, '_> {
                 Err(Fail::Bad(format!("byte {b:#04x}: this is binary data, but the header says `format ascii`")))
             }
             // The token's bytes are pulled: `advance` went over them.
-            _ => Ok(Some(&self.input.pulled()[start..self.pos]).filter(|t| !t.is_empty())),
+            _ => Ok(Some(self.input.slice(start..self.pos)).filter(|t| !t.is_empty())),
         }
     }
 
@@ -159,6 +161,11 @@ impl Cursor for Tokens<'_, '_> {
 
     fn remaining(&self) -> usize {
         self.input.remaining(self.pos)
+    }
+
+    #[inline]
+    fn release(&mut self) {
+        self.input.release(self.pos);
     }
 
     fn line(&self) -> Option<usize> {

@@ -3,33 +3,40 @@
 //! with lists (faces) are read item by item.
 
 use super::header::{Element, Header, Kind};
-use super::items::{self, Cursor, Fail, Parts};
+use super::items::{self, Cursor, Fail, Sink};
 use super::plan::{Job, Plan, Role, Target};
 use super::scalar::Scalar;
 use crate::error::Result;
+use crate::io::assemble;
 use crate::io::input::Input;
-use crate::mesh::Mesh;
 use std::path::Path;
 
-/// Reads the body that starts at byte `start` of `input`, in the given byte order.
+/// Reads the body that starts at byte `start` of `input`, in the given byte order, into `sink`.
 pub(crate) fn read(
     input: &mut Input,
     start: usize,
     big_endian: bool,
     header: &Header,
     plan: &Plan,
+    sink: &mut impl Sink,
     path: &Path,
-) -> Result<Mesh> {
+) -> Result<()> {
     let mut cursor = Bytes { input, pos: start, big_endian };
-    let mut parts = Parts::new(plan.vertex_count, plan.has_normals);
     for (element, job) in header.elements.iter().zip(&plan.jobs) {
+        if job.target == Target::Faces && !sink.wants_faces() {
+            break;
+        }
         match fixed_layout(element, job) {
-            Some(layout) => read_fixed(&mut cursor, element, &layout, &mut parts, path)?,
-            None => items::read_element(&mut cursor, element, job, &mut parts, path)?,
+            Some(layout) => read_fixed(&mut cursor, element, &layout, sink, path)?,
+            None => items::read_element(&mut cursor, element, job, plan.vertex_count, sink, path)?,
         }
     }
-    Ok(parts.into_mesh())
+    Ok(())
 }
+
+/// Fixed-size items are decoded in blocks of about this many bytes (1 MiB), so that a
+/// streaming input holds one block at a time.
+const BLOCK: usize = 1 << 20;
 
 /// Where to find the used values inside one fixed-size item.
 struct Layout {
@@ -55,34 +62,43 @@ fn fixed_layout(element: &Element, job: &Job) -> Option<Layout> {
     Some(Layout { stride, fields, vertices: job.target == Target::Vertices })
 }
 
-/// Decodes (or skips) all items of a fixed-size element in one pass over its bytes.
-fn read_fixed(cursor: &mut Bytes, element: &Element, layout: &Layout, parts: &mut Parts, path: &Path) -> Result<()> {
+/// Decodes (or skips) all items of a fixed-size element, a block of items at a time.
+fn read_fixed(cursor: &mut Bytes, element: &Element, layout: &Layout, sink: &mut impl Sink, path: &Path) -> Result<()> {
     if layout.stride == 0 {
         return Ok(());
     }
     let big_endian = cursor.big_endian;
     let start = cursor.pos;
-    let block = element.count.checked_mul(layout.stride).and_then(|size| cursor.take(size));
-    let Some(block) = block else {
-        let item = cursor.input.pulled().len().saturating_sub(start) / layout.stride;
-        return Err(items::error(path, None, element, item, Fail::End));
-    };
-    if !layout.vertices {
-        return Ok(());
+    let decode = layout.vertices && sink.wants_vertices();
+    if decode {
+        let room = assemble::capacity(element.count, cursor.remaining(), layout.stride);
+        sink.reserve_vertices(room).map_err(|fail| items::error(path, None, element, 0, fail))?;
     }
-    parts.reserve_vertices(element.count);
+    let per_block = (BLOCK / layout.stride).max(1);
     let mut coords = [0.0f64; 6];
-    for (item, bytes) in block.chunks_exact(layout.stride).enumerate() {
-        let mut decoded = Ok(());
-        for &(offset, ty, slot) in &layout.fields {
-            match bytes.get(offset..).and_then(|b| ty.decode(b, big_endian)) {
-                Some(value) => coords[slot] = value,
-                None => decoded = Err(Fail::End),
+    let mut first = 0;
+    while first < element.count {
+        let n = per_block.min(element.count - first);
+        let Some(block) = cursor.take(n * layout.stride) else {
+            let item = cursor.input.end().saturating_sub(start) / layout.stride;
+            return Err(items::error(path, None, element, item, Fail::End));
+        };
+        if decode {
+            for (k, bytes) in block.chunks_exact(layout.stride).enumerate() {
+                let mut decoded = Ok(());
+                for &(offset, ty, slot) in &layout.fields {
+                    match bytes.get(offset..).and_then(|b| ty.decode(b, big_endian)) {
+                        Some(value) => coords[slot] = value,
+                        None => decoded = Err(Fail::End),
+                    }
+                }
+                decoded
+                    .and_then(|()| sink.vertex(coords))
+                    .map_err(|fail| items::error(path, None, element, first + k, fail))?;
             }
         }
-        decoded
-            .and_then(|()| parts.push_vertex(coords).map_err(Fail::Bad))
-            .map_err(|fail| items::error(path, None, element, item, fail))?;
+        cursor.release();
+        first += n;
     }
     Ok(())
 }
@@ -122,6 +138,11 @@ impl Cursor for Bytes<'_, '_> {
 
     fn remaining(&self) -> usize {
         self.input.remaining(self.pos)
+    }
+
+    #[inline]
+    fn release(&mut self) {
+        self.input.release(self.pos);
     }
 
     fn line(&self) -> Option<usize> {

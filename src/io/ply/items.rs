@@ -7,6 +7,8 @@ use super::plan::{Job, Role, Target};
 use super::scalar::Scalar;
 use crate::error::{Error, Result};
 use crate::io::assemble;
+#[cfg(doc)]
+use crate::io::input::Input;
 use crate::mesh::Mesh;
 use glam::{DVec3, Vec3};
 use std::path::Path;
@@ -20,6 +22,9 @@ pub(crate) enum Fail {
     /// The item's line (text only) holds `found` values, fewer or more than the item needs.
     /// [`read_element`] turns this into a message with the expected count.
     Count { found: usize },
+    /// The sink stopped the reading with this error (the user cancelled, or the file cannot be
+    /// streamed as it is laid out); it is passed on as it is.
+    Stop(Error),
 }
 
 /// A source of values: tokens of an ASCII body, or bytes of a binary one.
@@ -43,8 +48,32 @@ pub(crate) trait Cursor {
     }
     /// Bytes not yet read.
     fn remaining(&self) -> usize;
+    /// Says that what was read so far will not be looked at again (see [`Input::release`]).
+    fn release(&mut self);
     /// The line of the current item, for text; `None` for binary.
     fn line(&self) -> Option<usize>;
+}
+
+/// What receives the items of a PLY body as they are read: vertices as `[x, y, z, nx, ny,
+/// nz]` (normals zero when the file has none) and polygons as checked vertex indices.
+pub(crate) trait Sink {
+    /// Whether vertices are wanted; when not, they are still checked to be there, not decoded.
+    fn wants_vertices(&self) -> bool {
+        true
+    }
+    /// Whether faces are wanted; when not, reading stops at the `face` element.
+    fn wants_faces(&self) -> bool {
+        true
+    }
+    /// Room for `n` more vertices (a header's count, bounded by the bytes left); a sink that
+    /// holds something per vertex refuses a count it has no memory for.
+    fn reserve_vertices(&mut self, _n: usize) -> Result<(), Fail> {
+        Ok(())
+    }
+    /// Room for `n` more polygons.
+    fn reserve_polygons(&mut self, _n: usize) {}
+    fn vertex(&mut self, c: [f64; 6]) -> Result<(), Fail>;
+    fn polygon(&mut self, polygon: &[u32]) -> Result<(), Fail>;
 }
 
 /// Positions, normals and triangles as they are read.
@@ -53,39 +82,51 @@ pub(crate) struct Parts {
     pub positions: Vec<DVec3>,
     pub normals: Option<Vec<Vec3>>,
     pub triangles: Vec<[u32; 3]>,
-    /// The vertex count the header declares; face indices are checked against it.
-    pub vertex_count: usize,
 }
 
 impl Parts {
-    /// Empty parts for a file with `vertex_count` vertices.
-    pub(crate) fn new(vertex_count: usize, has_normals: bool) -> Parts {
-        Parts { positions: Vec::new(), normals: has_normals.then(Vec::new), triangles: Vec::new(), vertex_count }
-    }
-
-    /// Reserves room for `n` more vertices.
-    pub(crate) fn reserve_vertices(&mut self, n: usize) {
-        self.positions.reserve(n);
-        if let Some(normals) = &mut self.normals {
-            normals.reserve(n);
-        }
-    }
-
-    /// Adds one vertex from `[x, y, z, nx, ny, nz]`.
-    #[inline]
-    pub(crate) fn push_vertex(&mut self, c: [f64; 6]) -> Result<(), String> {
-        let p = assemble::finite_position(DVec3::new(c[0], c[1], c[2]))?;
-        if let Some(normals) = &mut self.normals {
-            normals.push(assemble::finite_normal(DVec3::new(c[3], c[4], c[5]).as_vec3())?);
-        }
-        self.positions.push(p);
-        Ok(())
+    /// Empty parts, with normals if the file has them.
+    pub(crate) fn new(has_normals: bool) -> Parts {
+        Parts { positions: Vec::new(), normals: has_normals.then(Vec::new), triangles: Vec::new() }
     }
 
     /// The finished mesh.
     pub(crate) fn into_mesh(self) -> Mesh {
         assemble::mesh(self.positions, self.normals, self.triangles)
     }
+}
+
+impl Sink for Parts {
+    fn reserve_vertices(&mut self, n: usize) -> Result<(), Fail> {
+        self.positions.reserve(n);
+        if let Some(normals) = &mut self.normals {
+            normals.reserve(n);
+        }
+        Ok(())
+    }
+
+    fn reserve_polygons(&mut self, n: usize) {
+        self.triangles.reserve(n);
+    }
+
+    #[inline]
+    fn vertex(&mut self, c: [f64; 6]) -> Result<(), Fail> {
+        self.positions.push(position(c)?);
+        if let Some(normals) = &mut self.normals {
+            normals.push(assemble::finite_normal(DVec3::new(c[3], c[4], c[5]).as_vec3()).map_err(Fail::Bad)?);
+        }
+        Ok(())
+    }
+
+    fn polygon(&mut self, polygon: &[u32]) -> Result<(), Fail> {
+        assemble::push_fan(polygon, &mut self.triangles).map_err(Fail::Bad)
+    }
+}
+
+/// The checked position of a vertex read as `[x, y, z, ...]`.
+#[inline]
+pub(crate) fn position(c: [f64; 6]) -> Result<DVec3, Fail> {
+    assemble::finite_position(DVec3::new(c[0], c[1], c[2])).map_err(Fail::Bad)
 }
 
 /// A list length read as a number.
@@ -142,6 +183,7 @@ fn index(value: f64, vertex_count: usize) -> Result<u32, Fail> {
 pub(crate) fn error(path: &Path, line: Option<usize>, element: &Element, item: usize, fail: Fail) -> Error {
     let subject = format!("{} {item}", element.name);
     match (fail, line) {
+        (Fail::Stop(error), _) => error,
         (Fail::End, line) => Error::parse(
             path,
             line.map_or(subject.clone(), |n| format!("line {n}")),
@@ -158,12 +200,13 @@ pub(crate) fn error(path: &Path, line: Option<usize>, element: &Element, item: u
     }
 }
 
-/// Reads all items of `element`, adding what `job` asks for to `parts`.
+/// Reads all items of `element`, giving what `job` asks for to `sink`.
 pub(crate) fn read_element<C: Cursor>(
     cursor: &mut C,
     element: &Element,
     job: &Job,
-    parts: &mut Parts,
+    vertex_count: usize,
+    sink: &mut impl Sink,
     path: &Path,
 ) -> Result<()> {
     if element.properties.is_empty() {
@@ -171,11 +214,17 @@ pub(crate) fn read_element<C: Cursor>(
     }
     let min_bytes = 2 * element.properties.len();
     let room = assemble::capacity(element.count, cursor.remaining(), min_bytes);
-    match job.target {
-        Target::Vertices => parts.reserve_vertices(room),
-        Target::Faces => parts.triangles.reserve(room),
-        Target::Nothing => {}
-    }
+    let wanted = match job.target {
+        Target::Vertices if sink.wants_vertices() => {
+            sink.reserve_vertices(room).map_err(|fail| error(path, cursor.line(), element, 0, fail))?;
+            Target::Vertices
+        }
+        Target::Faces => {
+            sink.reserve_polygons(room);
+            Target::Faces
+        }
+        _ => Target::Nothing,
+    };
     let mut coords = [0.0f64; 6];
     let mut polygon = Vec::new();
     let fresh = Expected::new(element);
@@ -183,16 +232,15 @@ pub(crate) fn read_element<C: Cursor>(
         let mut expected = fresh;
         cursor
             .start_item()
-            .and_then(|()| {
-                read_item(cursor, element, job, parts.vertex_count, &mut coords, &mut polygon, &mut expected)
-            })
+            .and_then(|()| read_item(cursor, element, job, vertex_count, &mut coords, &mut polygon, &mut expected))
             .and_then(|()| cursor.finish_item())
-            .and_then(|()| match job.target {
-                Target::Vertices => parts.push_vertex(coords).map_err(Fail::Bad),
-                Target::Faces => assemble::push_fan(&polygon, &mut parts.triangles).map_err(Fail::Bad),
+            .and_then(|()| match wanted {
+                Target::Vertices => sink.vertex(coords),
+                Target::Faces => sink.polygon(&polygon),
                 Target::Nothing => Ok(()),
             })
             .map_err(|fail| error(path, cursor.line(), element, item, expected.explain(fail)))?;
+        cursor.release();
     }
     Ok(())
 }
