@@ -13,13 +13,18 @@
 //! ```text
 //! cargo bench --bench simplify -- [--ratios 0.02,0.005] [--runs N] [--models a,b]
 //!     [--data ../shared/data] [--curve igea,camel] [--curve-ratios ...] [--peers a,b]
-//!     [--large 3.5M,14M,50M] [--no-write]
+//!     [--large 3.5M,14M,50M] [--stream 14M,50M,200M] [--no-write]
 //! ```
+//!
+//! With `--stream`, the `vstree` command also simplifies generated tori of those sizes, and the
+//! `--large` inputs' files, streamed and read whole, for time and peak memory (`stream.rs`);
+//! `--models none` with no `--large` runs that part alone.
 
 #[path = "../common/mod.rs"]
 mod common;
 mod large;
 mod report;
+mod stream;
 
 use common::cli::{list, names, number, shown};
 use common::distance::Distances;
@@ -48,6 +53,9 @@ usage: cargo bench --bench simplify -- [options]
   --large A,B         also generated meshes of these sizes (3.5M, 14M, 50M: corpus meshes split
                       1-to-4 with a little noise, kept under target/bench-simplify/large/;
                       --models naming none of the data's skips those)
+  --stream A,B        also stream generated bumpy tori of these sizes (14M, 50M, 200M triangles,
+                      kept under target/bench-simplify/stream/) and the --large inputs' files
+                      through the vstree command, for time and peak memory
   --no-write          print the report only: do not update docs/benchmarks.md or the plots";
 
 /// The peers `benches/peers.py` runs, in the order the table shows them.
@@ -60,6 +68,9 @@ pub const VSTREE: [(&str, TreeKind, KeepTopology); 3] = [
     ("vstree VS-Tree clustering", TreeKind::VsTree, KeepTopology::Off),
     ("vstree octree clustering", TreeKind::Octree, KeepTopology::Off),
 ];
+
+/// The streamed mode's name, measured on the `--large` inputs (their files are PLY).
+pub const STREAMED: &str = "vstree streamed (plain)";
 
 /// The new mode, which the targets are about.
 pub const NEW_MODE: &str = VSTREE[0].0;
@@ -76,6 +87,7 @@ struct Options {
     threads: usize,
     peers: Vec<String>,
     large: Vec<String>,
+    stream: Vec<String>,
     write: bool,
 }
 
@@ -91,6 +103,7 @@ impl Options {
             threads: 0,
             peers: PEERS.iter().map(|p| p.to_string()).collect(),
             large: Vec::new(),
+            stream: Vec::new(),
             write: true,
         };
         let mut it = args.iter();
@@ -115,6 +128,7 @@ impl Options {
                     }
                 }
                 "--large" => o.large = names(value()?),
+                "--stream" => o.stream = names(value()?),
                 "--no-write" => o.write = false,
                 other => return Err(format!("unknown option {other}\n{USAGE}")),
             }
@@ -134,11 +148,36 @@ fn main() {
     common::cli::exit_on_help(&args, USAGE);
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let options = common::cli::or_exit(Options::parse(&args, &root));
-    let report = common::cli::or_fail("simplify", run(&options, &root, common::cli::command("simplify", &args)));
-    common::report::publish(&root, "simplify", &report.markdown(), options.write);
-    if options.write && !report.curve.is_empty() {
-        plot(&root, &report);
+    let command = common::cli::command("simplify", &args);
+    let only_stream = options.models.as_deref() == Some(&["none".to_string()][..]) && options.large.is_empty();
+    if !only_stream {
+        let report = common::cli::or_fail("simplify", run(&options, &root, command.clone()));
+        common::report::publish(&root, "simplify", &report.markdown(), options.write);
+        if options.write && !report.curve.is_empty() {
+            plot(&root, &report);
+        }
     }
+    if !options.stream.is_empty() {
+        let block = common::cli::or_fail("simplify", streamed(&options, &root, command));
+        common::report::publish(&root, "simplify-stream", &block, options.write);
+    }
+}
+
+/// The streaming table: the generated tori and the `--large` inputs' files.
+fn streamed(o: &Options, root: &Path, command: String) -> Result<String, String> {
+    let clock = Clock::start(command, o.threads);
+    let dir = root.join("target").join("bench-simplify");
+    let mut inputs = Vec::new();
+    for size in &o.large {
+        let (name, path, mesh) = large::mesh(size, &o.data, &dir.join("large"))?;
+        let faces = ((mesh.triangles.len() as f64 * 0.01).round() as usize).max(1);
+        inputs.push(stream::StreamInput { name, path, faces, torus: false });
+    }
+    for name in &o.stream {
+        inputs.push(stream::torus(name, &dir.join("stream"))?);
+    }
+    let table = stream::report(&inputs, &dir)?;
+    Ok(clock.run(Vec::new()).header() + "\n" + &table)
 }
 
 /// One input: a triangle mesh read from the data directory.
@@ -249,6 +288,21 @@ fn vstree_run(
     Ok((median(&times), out))
 }
 
+/// vstree's streamed simplification of the PLY file at `path` to `target` triangles `runs`
+/// times: the median time (reading included: it reads as it goes) and the output.
+fn streamed_run(path: &Path, target: usize, threads: usize, runs: usize) -> vstree::Result<(f64, Mesh)> {
+    let params = SimplifyParams { target_faces: target, threads, ..Default::default() };
+    let mut times = Vec::new();
+    let mut out = Mesh::default();
+    for _ in 0..runs {
+        let start = Instant::now();
+        let (mesh, _) = vstree::simplify::simplify_ply_streaming(path, &params, &mut Progress::none())?;
+        times.push(start.elapsed().as_secs_f64());
+        out = mesh;
+    }
+    Ok((median(&times), out))
+}
+
 fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     let clock = Clock::start(command, o.threads);
     let mut rows = Vec::new();
@@ -256,6 +310,7 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     let mut notes = Vec::new();
     let out_dir = root.join("target").join("bench-simplify");
     let mut inputs = inputs(&o.data, o.models.as_deref());
+    let first_large = inputs.len();
     for size in &o.large {
         eprintln!("simplify: the {size} input (generated on first use)");
         let (name, path, mesh) = large::mesh(size, &o.data, &out_dir.join("large"))?;
@@ -264,7 +319,7 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     if inputs.is_empty() {
         return Err(format!("no triangle mesh in {}", shown(&o.data, root)));
     }
-    for input in &inputs {
+    for (index, input) in inputs.iter().enumerate() {
         let on_curve = o.curve.contains(&input.name);
         let mut ratios = o.ratios.clone();
         if on_curve {
@@ -286,6 +341,11 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
                     None
                 };
                 measured.push(row(input, ratio, method, seconds, one, &out));
+            }
+            if index >= first_large {
+                let (seconds, out) =
+                    streamed_run(&input.path, target, o.threads, o.runs).map_err(|e| format!("{}: {e}", input.name))?;
+                measured.push(row(input, ratio, STREAMED, seconds, None, &out));
             }
         }
         if !o.peers.is_empty() {
@@ -321,7 +381,7 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
         }
     }
     // By size, then model (in reading order), then method (vstree's, then the peers').
-    let methods: Vec<&str> = VSTREE.iter().map(|v| v.0).chain(PEERS).collect();
+    let methods: Vec<&str> = VSTREE.iter().map(|v| v.0).chain([STREAMED]).chain(PEERS).collect();
     let models: Vec<&str> = inputs.iter().map(|i| i.name.as_str()).collect();
     let key = |r: &Row| {
         let at = |v: &[&str], x: &str| v.iter().position(|&y| y == x).unwrap_or(usize::MAX);
