@@ -11,10 +11,10 @@
 use crate::collapse::Collapser;
 use crate::linalg::Sym3;
 use crate::mesh::Mesh;
+use crate::quad_heap::QuadHeap;
 use crate::quadric::CellStats;
 use glam::DVec3;
 use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 
 /// A collapse is refused when it would turn one of the faces around it by more than the angle
 /// with this cosine (unitless; 0 = a right angle): beyond that the face folds over its
@@ -73,7 +73,7 @@ struct Decimator {
     positions: Vec<DVec3>,
     quadrics: Vec<CellStats>,
     versions: Vec<u32>,
-    heap: BinaryHeap<Candidate>,
+    heap: QuadHeap<Candidate>,
 }
 
 /// Collapses edges of `mesh` (proper triangles, every vertex used) until it has at most
@@ -90,7 +90,7 @@ pub(crate) fn decimate(mesh: &Mesh, quadrics: Vec<CellStats>, origin: DVec3, tar
         positions: mesh.positions.iter().map(|p| p.as_dvec3() - origin).collect(),
         quadrics,
         versions: vec![0; n],
-        heap: BinaryHeap::new(),
+        heap: QuadHeap::new(),
     };
     let mut faces = mesh.triangles.len();
     let mut used = vec![false; n];
@@ -352,7 +352,7 @@ mod tests {
             positions: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
             quadrics: face_quadrics(&mesh),
             versions: vec![0; 5],
-            heap: BinaryHeap::new(),
+            heap: QuadHeap::new(),
         };
         // Inside the fan nothing turns; past vertex 4 faces 0-3-4 and 0-4-1 turn over.
         assert!(!d.folds(2, 0, DVec3::new(0.0, 0.5, 0.0)));

@@ -18,6 +18,7 @@ pub mod mesh;
 pub mod normals;
 mod polygonise;
 pub mod progress;
+mod quad_heap;
 pub mod quadric;
 pub mod reconstruct;
 pub mod rng;
