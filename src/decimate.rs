@@ -21,6 +21,10 @@ use std::cmp::Ordering;
 /// neighbours, which a quadric cannot see because it only measures distances to planes.
 const FOLD_COSINE: f64 = 0.0;
 
+/// The queue is cleared of stale candidates when it holds more than this many per triangle
+/// left (unitless; a mesh has about 1.5 edges per triangle, so about twice the live ones).
+const STALE_RATIO: usize = 3;
+
 /// A candidate collapse: `gone` merges into `keep`, for `cost`; `versions` are the two
 /// vertices' versions when it was planned (stale once either changes). Where they meet is
 /// worked out again when it is taken ([`Decimator::placement`], the same answer while the
@@ -105,6 +109,7 @@ pub(crate) fn decimate(mesh: &Mesh, quadrics: Vec<CellStats>, origin: DVec3, tar
         d.seed(mesh);
         let before = faces;
         while faces >= target + 2 {
+            d.drop_stale(faces);
             let Some(c) = d.heap.pop() else { break };
             if d.versions[c.gone as usize] != c.versions[0] || d.versions[c.keep as usize] != c.versions[1] {
                 continue;
@@ -254,6 +259,18 @@ impl Decimator {
         false
     }
 
+    /// Drops the candidates made stale by collapses once they outnumber the live edges of a mesh
+    /// of `faces` triangles (about 1.5 per triangle): each would cost a pop, and most get
+    /// popped, since a collapse raises its neighbours' costs and the stale entries keep the
+    /// old, lower ones. The pops that remain come in the same order.
+    fn drop_stale(&mut self, faces: usize) {
+        if self.heap.len() > STALE_RATIO * faces {
+            let versions = &self.versions;
+            self.heap
+                .retain(|c| versions[c.gone as usize] == c.versions[0] && versions[c.keep as usize] == c.versions[1]);
+        }
+    }
+
     fn apply(&mut self, c: &Candidate, position: DVec3) {
         let q = self.quadrics[c.gone as usize];
         self.quadrics[c.keep as usize].merge(&q);
@@ -330,6 +347,31 @@ mod tests {
             assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.components), (0, 0, 1), "{r:?}");
             assert_eq!(r.euler_characteristic, before.euler_characteristic, "a disk stays a disk");
             assert!(r.boundary_edges >= 3 && r.boundary_edges < before.boundary_edges);
+        }
+    }
+
+    #[test]
+    fn stale_candidates_are_dropped_once_they_crowd_the_queue() {
+        let mesh = shapes::icosphere(1.0, 2);
+        let n = mesh.positions.len();
+        let mut d = Decimator {
+            collapser: Collapser::new(&mesh),
+            positions: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
+            quadrics: face_quadrics(&mesh),
+            versions: vec![0; n],
+            heap: QuadHeap::new(),
+        };
+        d.seed(&mesh);
+        let edges = d.heap.len();
+        assert_eq!(edges, 3 * mesh.triangles.len() / 2);
+        // Under the ratio nothing is dropped; above it, every candidate of a changed vertex.
+        d.versions[0] += 1;
+        d.drop_stale(mesh.triangles.len());
+        assert_eq!(d.heap.len(), edges);
+        d.drop_stale(edges / STALE_RATIO - 1);
+        assert_eq!(d.heap.len(), edges - 5, "vertex 0 of an icosphere has 5 edges");
+        while let Some(c) = d.heap.pop() {
+            assert!(c.gone != 0 && c.keep != 0);
         }
     }
 

@@ -32,6 +32,18 @@ impl<T: Ord> QuadHeap<T> {
         }
     }
 
+    pub(crate) fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// Keeps only the items `keep` accepts, in heap order again (in linear time).
+    pub(crate) fn retain(&mut self, keep: impl FnMut(&T) -> bool) {
+        self.items.retain(keep);
+        for at in (0..self.items.len().div_ceil(4)).rev() {
+            self.sift_down(at);
+        }
+    }
+
     /// The greatest item, removed.
     pub(crate) fn pop(&mut self) -> Option<T> {
         let last = self.items.pop()?;
@@ -39,8 +51,13 @@ impl<T: Ord> QuadHeap<T> {
             return Some(last);
         }
         let top = std::mem::replace(&mut self.items[0], last);
+        self.sift_down(0);
+        Some(top)
+    }
+
+    /// Moves the item at `at` down until no child is greater.
+    fn sift_down(&mut self, mut at: usize) {
         let n = self.items.len();
-        let mut at = 0;
         loop {
             let first = 4 * at + 1;
             if first >= n {
@@ -51,7 +68,6 @@ impl<T: Ord> QuadHeap<T> {
             self.items.swap(at, child);
             at = child;
         }
-        Some(top)
     }
 }
 
@@ -75,6 +91,10 @@ mod tests {
                 binary.push(x);
             }
         }
+        // Dropping the odd values keeps the rest in order.
+        quad.retain(|x| x % 2 == 0);
+        binary.retain(|x| x % 2 == 0);
+        assert_eq!(quad.len(), binary.len());
         while let Some(x) = binary.pop() {
             assert_eq!(quad.pop(), Some(x));
         }
