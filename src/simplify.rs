@@ -196,7 +196,7 @@ pub fn cluster_mesh(
 pub fn simplify(mesh: &Mesh, params: &SimplifyParams, progress: &mut Progress) -> Result<(Mesh, SimplifyStats)> {
     let threads = Threads::new(params.threads)?;
     params.check()?;
-    check_target(mesh, params.target_faces)?;
+    check_target(mesh.triangles.len(), params.target_faces)?;
     let keep = !mesh.is_point_cloud()
         && match params.keep_topology {
             KeepTopology::On => true,
@@ -293,21 +293,18 @@ fn collapsed(tree: &VsTree, what: &str) -> Error {
 }
 
 /// Refuses a target the input cannot give: more triangles than it has, or any on a cloud.
-fn check_target(mesh: &Mesh, target: usize) -> Result<()> {
+fn check_target(triangles: usize, target: usize) -> Result<()> {
     if target == 0 {
         return Ok(());
     }
-    if mesh.triangles.is_empty() {
+    if triangles == 0 {
         return Err(Error::param(
             "target_faces",
             format!("{target} triangles asked of a point cloud: a target needs a mesh (use the error bound)"),
         ));
     }
-    if target > mesh.triangles.len() {
-        return Err(Error::param(
-            "target_faces",
-            format!("{target}: more than the input's {} triangles", mesh.triangles.len()),
-        ));
+    if target > triangles {
+        return Err(Error::param("target_faces", format!("{target}: more than the input's {triangles} triangles")));
     }
     Ok(())
 }

@@ -19,12 +19,12 @@
 //! result is plain clustering's, where sheets closer than a cluster may fuse.
 
 use super::{
-    cluster_with_stats, clusters_for, collapse, collapse_to_target, seed_tree, SimplifyParams, SimplifyStats,
-    MAX_ROUNDS,
+    check_target, cluster_with_stats, clusters_for, collapse, collapse_to_target, seed_tree, SimplifyParams,
+    SimplifyStats, MAX_ROUNDS,
 };
 use crate::error::{Error, Result};
-use crate::io::assemble;
 use crate::io::ply::{self, Declared, Fail, Sink};
+use crate::io::{assemble, Format};
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
 use crate::quadric::CellStats;
@@ -40,10 +40,10 @@ use std::path::Path;
 use std::time::Instant;
 
 /// Samples taken per cluster the target needs (unitless): the tree decides its splits and the
-/// clusters their planes from these alone. On the 3.2M-triangle bull to 2%, 4 and 8 give the
-/// same Chamfer distance (0.0159% of the diagonal; in memory 0.0116%); on the 18M-triangle
-/// cheese, 8 gives 0.0209%, 4 0.0266%, 16 0.0172% (in memory 0.0108%); 8 keeps a 200M-triangle
-/// file to 1M triangles under 1 GB (docs/benchmarks.md).
+/// clusters their planes from these alone. A one-off probe (Chamfer to the input, 2%) found 4
+/// and 8 alike on the 3.2M-triangle bull, and on the 18M-triangle cheese 8 at 0.0209% of the
+/// diagonal, 4 at 0.0266%, 16 at 0.0172%; 8 keeps a 200M-triangle file to 1M triangles under
+/// 1 GB (`cargo bench --bench simplify -- --models none --stream 200M`, docs/benchmarks.md).
 const SAMPLES_PER_CLUSTER: usize = 8;
 
 /// The fewest samples taken (when the input has as many triangles): a small target still gets
@@ -72,10 +72,7 @@ pub fn simplify_ply_streaming(
     let declared = ply::declared(path)?;
     let target = params.target_faces;
     if declared.faces == 0 {
-        return Err(Error::param(
-            "target_faces",
-            format!("{target} triangles asked of a point cloud: a target needs a mesh (use the error bound)"),
-        ));
+        check_target(0, target)?; // a point cloud
     }
     if !declared.vertices_first {
         return Err(Error::input(format!(
@@ -87,12 +84,7 @@ pub fn simplify_ply_streaming(
     let want = clusters_for(target, None, 1.0);
     let budget = (SAMPLES_PER_CLUSTER * want).max(MIN_SAMPLES);
     let chosen = choose_triangles(path, &declared, budget, &mut progress.stage(0.0, 0.3))?;
-    if target > chosen.triangles {
-        return Err(Error::param(
-            "target_faces",
-            format!("{target}: more than the input's {} triangles", chosen.triangles),
-        ));
-    }
+    check_target(chosen.triangles, target)?;
     let gathered = gather_vertices(path, &declared, &chosen, &mut progress.stage(0.3, 0.45))?;
     let samples = gathered.samples(&chosen.triangles_kept, &chosen.needed);
     let (input_triangles, origin) = (chosen.triangles, gathered.origin);
@@ -145,7 +137,7 @@ pub fn simplify_ply_streaming(
 
 /// Refuses what a stream cannot do, before the file is read.
 fn refuse(path: &Path, params: &SimplifyParams) -> Result<()> {
-    if crate::io::Format::from_path(path) != Some(crate::io::Format::Ply) {
+    if Format::from_path(path) != Some(Format::Ply) {
         return Err(Error::input(format!(
             "{}: only PLY files are streamed; convert it, or simplify it in memory",
             path.display()
@@ -230,6 +222,8 @@ struct ChooseTriangles<'p, 'q> {
     chosen: Chosen,
     /// A triangle is chosen when its hash is below this.
     threshold: u64,
+    /// The current polygon's triangles (kept to reuse its room).
+    fan: Vec<[u32; 3]>,
     polygons: usize,
     total: usize,
     progress: &'p mut Progress<'q>,
@@ -241,9 +235,9 @@ impl Sink for ChooseTriangles<'_, '_> {
     }
 
     fn polygon(&mut self, polygon: &[u32]) -> Result<(), Fail> {
-        let mut fan = Vec::with_capacity(polygon.len());
-        assemble::push_fan(polygon, &mut fan).map_err(Fail::Bad)?;
-        for tri in fan {
+        self.fan.clear();
+        assemble::push_fan(polygon, &mut self.fan).map_err(Fail::Bad)?;
+        for &tri in &self.fan {
             if rng::stream_seed(SAMPLE_SEED, self.chosen.triangles as u64) < self.threshold {
                 tri.iter().for_each(|&v| self.chosen.needed.insert(v));
                 self.chosen.triangles_kept.push(tri);
@@ -264,6 +258,7 @@ fn choose_triangles(path: &Path, declared: &Declared, budget: usize, progress: &
     let mut sink = ChooseTriangles {
         chosen: Chosen { triangles_kept: Vec::new(), needed: BitSet::new(declared.vertices)?, triangles: 0 },
         threshold: (share * u64::MAX as f64) as u64,
+        fan: Vec::new(),
         polygons: 0,
         total: declared.faces,
         progress,
@@ -473,7 +468,7 @@ impl Sink for Label<'_, '_, '_> {
     }
 }
 
-/// The triangles of clusters: each vertex in the cluster of the leaf nearest it (positions
+/// The triangles of clusters: each vertex in the cluster of the sample nearest it (positions
 /// relative to `origin`, the tree's frame), each triangle of three distinct clusters once.
 fn label(
     path: &Path,

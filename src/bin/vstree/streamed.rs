@@ -6,9 +6,10 @@ use std::path::Path;
 use vstree::io::{ply, Format};
 use vstree::simplify::KeepTopology;
 
-/// The in-memory path's peak, in multiples of a binary PLY file's size (unitless): a 14M-triangle
-/// mesh of 266 MB peaked at 1.9 GB with the topology kept (docs/benchmarks.md), so a file larger
-/// than the memory available over this streams by default.
+/// The in-memory path's peak, in multiples of a binary PLY file's size (unitless): read whole
+/// with the topology kept, the 18M-triangle cheese (346 MB) peaked at 1.93 GB (5.6x) and a
+/// 14M-triangle torus (253 MB) at 1.28 GB (5.0x, docs/benchmarks.md); with a margin, a file
+/// larger than the memory available over this streams by default.
 const MEMORY_PER_FILE_BYTE: u64 = 8;
 
 /// The faces the PLY header declares when the input is to be streamed, `None` when it is read
