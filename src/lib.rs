@@ -5,6 +5,7 @@
 //! surface's local frame, near it. It gives better-balanced clusters than an octree for
 //! clustering simplification, and drives a fast point-to-mesh reconstruction.
 
+mod chunks;
 mod collapse;
 mod decimate;
 pub mod error;

@@ -7,9 +7,10 @@
 //! seams and the borders, and the clusters' survivors) is a fraction of the input, which the
 //! serial pass then finishes.
 
+use crate::chunks::{morton_chunks, submesh, Chunks};
 use crate::collapse::Collapser;
 use crate::mesh::Mesh;
-use glam::{UVec3, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 
 /// Input triangles per chunk: chunks as large as this cost little in seams (the vertices along
@@ -32,61 +33,14 @@ pub(super) fn collapse_inside_chunks(
     if chunks < 2 || clusters == 0 {
         return None;
     }
-    // Clusters in Morton order of their representatives, cut into runs of equal length.
-    let (low, high) =
-        representatives.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &p| (l.min(p), h.max(p)));
-    let scale = 1023.0 / (high - low).max_element().max(f32::MIN_POSITIVE);
-    let mut order: Vec<(u32, u32)> = representatives
-        .par_iter()
-        .enumerate()
-        .map(|(c, &p)| (morton(((p - low) * scale).as_uvec3()), c as u32))
-        .collect();
-    order.par_sort_unstable();
-    let mut chunk_of_cluster = vec![0u32; clusters];
-    for (rank, &(_, c)) in order.iter().enumerate() {
-        chunk_of_cluster[c as usize] = (rank * chunks / clusters) as u32;
-    }
-    let chunk_of = |v: u32| chunk_of_cluster[labels[v as usize] as usize];
-    // Per triangle its chunk, or `chunks` where its corners lie in different ones (a seam).
-    let chunk_of_triangle: Vec<u32> = mesh
-        .triangles
-        .par_iter()
-        .map(|t| {
-            let c = chunk_of(t[0]);
-            if chunk_of(t[1]) == c && chunk_of(t[2]) == c {
-                c
-            } else {
-                chunks as u32
-            }
-        })
-        .collect();
-    // Vertices whose star is not whole in one chunk wait (and, found in each chunk, those on
-    // a border).
-    let mut seam = vec![false; mesh.positions.len()];
-    for (t, _) in chunk_of_triangle.iter().enumerate().filter(|(_, &c)| c as usize == chunks) {
-        for v in mesh.triangles[t] {
-            seam[v as usize] = true;
-        }
-    }
-    // The triangles of each chunk (the seams' last), by a counting sort.
-    let mut start = vec![0usize; chunks + 3];
-    for &c in &chunk_of_triangle {
-        start[c as usize + 2] += 1;
-    }
-    for c in 2..start.len() {
-        start[c] += start[c - 1];
-    }
-    let mut by_chunk = vec![0u32; chunk_of_triangle.len()];
-    for (t, &c) in chunk_of_triangle.iter().enumerate() {
-        by_chunk[start[c as usize + 1]] = t as u32;
-        start[c as usize + 1] += 1;
-    }
-    let runs: Vec<&[u32]> = (0..=chunks).map(|c| &by_chunk[start[c]..start[c + 1]]).collect();
+    let chunk_of_cluster = morton_chunks(representatives, chunks, 0.0);
+    let parts = Chunks::new(mesh, chunks, |v| chunk_of_cluster[labels[v as usize] as usize]);
+    let runs = parts.runs();
     let merged: Vec<(Vec<u32>, Mesh)> =
-        runs[..chunks].par_iter().map(|run| collapse_chunk(mesh, labels, &seam, run)).collect();
+        runs.par_iter().map(|run| collapse_chunk(mesh, labels, &parts.seam, run)).collect();
     // The survivors, with the seams' triangles as they were.
     let mut positions = mesh.positions.clone();
-    let mut triangles: Vec<[u32; 3]> = runs[chunks].iter().map(|&t| mesh.triangles[t as usize]).collect();
+    let mut triangles: Vec<[u32; 3]> = parts.triangles(chunks).iter().map(|&t| mesh.triangles[t as usize]).collect();
     for (global, part) in &merged {
         for (&g, &p) in global.iter().zip(&part.positions) {
             positions[g as usize] = p;
@@ -103,16 +57,7 @@ pub(super) fn collapse_inside_chunks(
 /// get labels of their own, so no collapse takes them. Returns the submesh left and, per vertex
 /// of it, its index in `mesh`.
 fn collapse_chunk(mesh: &Mesh, labels: &[u32], seam: &[bool], triangles: &[u32]) -> (Vec<u32>, Mesh) {
-    let triangles: Vec<[u32; 3]> = triangles.iter().map(|&t| mesh.triangles[t as usize]).collect();
-    let mut vertices: Vec<u32> = triangles.iter().flatten().copied().collect();
-    vertices.sort_unstable();
-    vertices.dedup();
-    let local = |v: u32| vertices.binary_search(&v).unwrap_or(0) as u32;
-    let sub = Mesh::new(
-        vertices.iter().map(|&v| mesh.positions[v as usize]).collect(),
-        None,
-        triangles.iter().map(|t| t.map(local)).collect(),
-    );
+    let (vertices, sub) = submesh(mesh, triangles);
     let mut collapser = Collapser::new(&sub);
     // A vertex off the seams has its whole star here, so a border here is the mesh's border.
     // Labels of their own: above every cluster's, one per vertex.
@@ -133,18 +78,6 @@ fn collapse_chunk(mesh: &Mesh, labels: &[u32], seam: &[bool], triangles: &[u32])
         (0..vertices.len() as u32).filter(|&v| collapser.is_alive(v)).map(|v| vertices[v as usize]).collect();
     let (left, _) = collapser.finish(&sub_labels);
     (survivors, left)
-}
-
-/// The Morton code of a point of a 1024-cell grid: its coordinates' bits interleaved.
-fn morton(p: UVec3) -> u32 {
-    let spread = |x: u32| {
-        let mut x = x.min(1023);
-        x = (x | x << 16) & 0x0300_00ff;
-        x = (x | x << 8) & 0x0300_f00f;
-        x = (x | x << 4) & 0x030c_30c3;
-        (x | x << 2) & 0x0924_9249
-    };
-    spread(p.x) | spread(p.y) << 1 | spread(p.z) << 2
 }
 
 #[cfg(test)]
