@@ -8,12 +8,17 @@
 //! a border keeps its course. Used after clustering, to bring a simplification to the exact
 //! size asked for.
 
+mod chunks;
+
 use crate::collapse::Collapser;
 use crate::linalg::Sym3;
 use crate::mesh::Mesh;
+use crate::progress::Threads;
 use crate::quad_heap::QuadHeap;
 use crate::quadric::CellStats;
+use chunks::{decimate_in_chunks, Near};
 use glam::DVec3;
+use rayon::prelude::*;
 use std::cmp::Ordering;
 
 /// A collapse is refused when it would turn one of the faces around it by more than the angle
@@ -24,6 +29,11 @@ const FOLD_COSINE: f64 = 0.0;
 /// The queue is cleared of stale candidates when it holds more than this many per triangle
 /// left (unitless; a mesh has about 1.5 edges per triangle, so about twice the live ones).
 const STALE_RATIO: usize = 3;
+
+/// Where the grids of the chunked passes lie (a fraction of the mesh's box, see
+/// [`crate::chunks::morton_chunks`]): the second pass, its seams elsewhere, takes what the
+/// first left locked along its seams, in parallel too, so the serial pass has little left.
+const CHUNK_SHIFTS: [f32; 2] = [0.0, 0.37];
 
 /// A candidate collapse: `gone` merges into `keep`, for `cost`; `versions` are the two
 /// vertices' versions when it was planned (stale once either changes). Where they meet is
@@ -40,6 +50,13 @@ struct Candidate {
     /// Whether it was planned as edge gone-keep (else keep-gone): the placement's ties follow
     /// the order.
     gone_first: bool,
+}
+
+impl Candidate {
+    /// Whether it was planned on the vertices as they are (`versions` per vertex).
+    fn is_current(&self, versions: &[u32]) -> bool {
+        versions[self.gone as usize] == self.versions[0] && versions[self.keep as usize] == self.versions[1]
+    }
 }
 
 impl PartialEq for Candidate {
@@ -78,73 +95,153 @@ struct Decimator {
     quadrics: Vec<CellStats>,
     versions: Vec<u32>,
     heap: QuadHeap<Candidate>,
+    /// Vertices no collapse may move or take (a chunk's seams).
+    locked: Vec<bool>,
+    /// Live triangles.
+    faces: usize,
 }
 
 /// Collapses edges of `mesh` (proper triangles, every vertex used) until it has at most
 /// `target + 1` triangles (an interior collapse removes two, a border one one), or no allowed
 /// collapse is left.
 /// `quadrics[v]` is vertex v's quadric, over positions relative to `origin` (in the mesh's
-/// frame). Returns the mesh, with the input's winding, and the input vertex each output vertex
-/// is.
-pub(crate) fn decimate(mesh: &Mesh, quadrics: Vec<CellStats>, origin: DVec3, target: usize) -> (Mesh, Vec<u32>) {
-    let n = mesh.positions.len();
-    debug_assert_eq!(quadrics.len(), n);
-    let mut d = Decimator {
-        collapser: Collapser::new(mesh),
-        positions: mesh.positions.iter().map(|p| p.as_dvec3() - origin).collect(),
-        quadrics,
-        versions: vec![0; n],
-        heap: QuadHeap::new(),
-    };
-    let mut faces = mesh.triangles.len();
-    let mut used = vec![false; n];
-    for &v in mesh.triangles.iter().flatten() {
-        used[v as usize] = true;
-    }
-    for (v, _) in used.iter().enumerate().filter(|(_, &u)| !u) {
-        d.collapser.remove_vertex(v);
-    }
-    d.add_border_planes(mesh);
-    while faces >= target + 2 {
-        d.seed(mesh);
-        let before = faces;
-        while faces >= target + 2 {
-            d.drop_stale(faces);
-            let Some(c) = d.heap.pop() else { break };
-            if d.versions[c.gone as usize] != c.versions[0] || d.versions[c.keep as usize] != c.versions[1] {
-                continue;
-            }
-            let allowed = if c.border {
-                d.collapser.can_collapse_border(c.gone, c.keep)
-            } else {
-                d.collapser.can_collapse(c.gone, c.keep)
-            };
-            let (u, v) = if c.gone_first { (c.gone, c.keep) } else { (c.keep, c.gone) };
-            let Some(Placement { position, .. }) = d.placement(u, v) else { continue };
-            if !allowed || d.folds(c.gone, c.keep, position) {
-                continue;
-            }
-            faces -= if c.border { 1 } else { 2 };
-            d.apply(&c, position);
-        }
-        if faces == before {
-            break; // a whole pass over every edge found nothing to collapse
+/// frame). A large mesh is first brought near the target in chunks, in parallel
+/// ([`decimate_in_chunks`]), twice. Returns the mesh, with the input's winding, and the input vertex
+/// each output vertex is.
+pub(crate) fn decimate(
+    mesh: &Mesh,
+    mut quadrics: Vec<CellStats>,
+    origin: DVec3,
+    target: usize,
+    threads: &Threads,
+) -> (Mesh, Vec<u32>) {
+    debug_assert_eq!(quadrics.len(), mesh.positions.len());
+    let positions: Vec<DVec3> = mesh.positions.iter().map(|p| p.as_dvec3() - origin).collect();
+    add_border_planes(mesh, &positions, &mut quadrics);
+    let mut near = Near { mesh: mesh.clone(), positions, quadrics, from: (0..mesh.positions.len() as u32).collect() };
+    for shift in CHUNK_SHIFTS {
+        if let Some(next) = threads.run(|| decimate_in_chunks(&near, target, shift)) {
+            near = next;
         }
     }
-    let identity: Vec<u32> = (0..n as u32).collect();
+    let Near { mesh: near, positions, quadrics, from } = near;
+    let mut d = Decimator::new(&near, positions, quadrics, None);
+    d.run(target);
+    let identity: Vec<u32> = (0..near.positions.len() as u32).collect();
     let (mut out, kept) = d.collapser.finish(&identity);
     for (p, &v) in out.positions.iter_mut().zip(&kept) {
         *p = (d.positions[v as usize] + origin).as_vec3();
     }
-    (out, kept)
+    (out, kept.iter().map(|&v| from[v as usize]).collect())
+}
+
+/// Adds to the quadric of each border edge's ends the plane through the edge across its
+/// face, weighted like one vertex's samples (the mean count of samples per vertex), so a
+/// border that moves costs as much as a surface that does.
+fn add_border_planes(mesh: &Mesh, positions: &[DVec3], quadrics: &mut [CellStats]) {
+    let n = quadrics.len().max(1) as f64;
+    let weight = quadrics.iter().map(|q| q.count as f64).sum::<f64>() / n;
+    let mut edges: Vec<((u32, u32), u32)> = Vec::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            edges.push(((a.min(b), a.max(b)), t as u32));
+        }
+    }
+    edges.par_sort_unstable();
+    for (i, &((a, b), t)) in edges.iter().enumerate() {
+        let alone = (i == 0 || edges[i - 1].0 != (a, b)) && edges.get(i + 1).is_none_or(|e| e.0 != (a, b));
+        if !alone {
+            continue;
+        }
+        let [x, y, z] = mesh.triangles[t as usize].map(|v| positions[v as usize]);
+        let normal = (y - x).cross(z - x);
+        let (pa, pb) = (positions[a as usize], positions[b as usize]);
+        let across = (pb - pa).cross(normal).normalize_or_zero();
+        if across == DVec3::ZERO {
+            continue;
+        }
+        let d = across.dot(pa);
+        for v in [a, b] {
+            let q = &mut quadrics[v as usize];
+            q.nn.add(&Sym3::outer(across).scaled(weight));
+            q.b += across * (d * weight);
+            q.c += d * d * weight;
+        }
+    }
 }
 
 impl Decimator {
+    /// A decimation of `mesh` (proper triangles) with its vertices' `positions` and
+    /// `quadrics`, the `locked` ones fixed; vertices no triangle uses are left out.
+    fn new(mesh: &Mesh, positions: Vec<DVec3>, quadrics: Vec<CellStats>, locked: Option<Vec<bool>>) -> Decimator {
+        let n = mesh.positions.len();
+        let mut d = Decimator {
+            collapser: Collapser::new(mesh),
+            positions,
+            quadrics,
+            versions: vec![0; n],
+            heap: QuadHeap::new(),
+            locked: locked.unwrap_or_else(|| vec![false; n]),
+            faces: mesh.triangles.len(),
+        };
+        let mut used = vec![false; n];
+        for &v in mesh.triangles.iter().flatten() {
+            used[v as usize] = true;
+        }
+        for (v, _) in used.iter().enumerate().filter(|(_, &u)| !u) {
+            d.collapser.remove_vertex(v);
+        }
+        d
+    }
+
+    /// Takes the cheapest allowed collapse while more than `target + 1` triangles are left.
+    fn run(&mut self, target: usize) {
+        while self.faces >= target + 2 {
+            self.seed();
+            let before = self.faces;
+            while self.faces >= target + 2 {
+                let Some(c) = self.next() else { break };
+                self.take(c);
+            }
+            if self.faces == before {
+                break; // a whole pass over every edge found nothing to collapse
+            }
+        }
+    }
+
+    /// The cheapest candidate, off the queue (stale ones are dropped now and then).
+    fn next(&mut self) -> Option<Candidate> {
+        self.drop_stale(self.faces);
+        self.heap.pop()
+    }
+
+    /// Takes collapse `c` if it still holds (its vertices unchanged since it was planned) and
+    /// is allowed (topology, folds); whether it did.
+    fn take(&mut self, c: Candidate) -> bool {
+        if !c.is_current(&self.versions) {
+            return false;
+        }
+        let allowed = if c.border {
+            self.collapser.can_collapse_border(c.gone, c.keep)
+        } else {
+            self.collapser.can_collapse(c.gone, c.keep)
+        };
+        let (u, v) = if c.gone_first { (c.gone, c.keep) } else { (c.keep, c.gone) };
+        let Some(Placement { position, .. }) = self.placement(u, v) else { return false };
+        if !allowed || self.folds(c.gone, c.keep, position) {
+            return false;
+        }
+        self.faces -= if c.border { 1 } else { 2 };
+        self.apply(&c, position);
+        true
+    }
+
     /// Fills the heap with every live edge (once each).
-    fn seed(&mut self, mesh: &Mesh) {
+    fn seed(&mut self) {
         self.heap.clear();
         let mut edges: Vec<(u32, u32)> = Vec::new();
-        for v in 0..mesh.positions.len() as u32 {
+        for v in 0..self.positions.len() as u32 {
             if !self.collapser.is_alive(v) {
                 continue;
             }
@@ -172,6 +269,9 @@ impl Decimator {
     /// The collapse [`Decimator::plan`] queues for edge u-v: which end goes, where they meet,
     /// at what cost; `None` when it is not allowed.
     fn placement(&self, u: u32, v: u32) -> Option<Placement> {
+        if self.locked[u as usize] || self.locked[v as usize] {
+            return None;
+        }
         let (bu, bv) = (self.collapser.is_border(u), self.collapser.is_border(v));
         let border = bu && bv;
         if border && self.collapser.edge_faces(u, v) != 1 {
@@ -197,45 +297,6 @@ impl Decimator {
             (u.max(v), u.min(v), best.unwrap_or(x))
         };
         Some(Placement { gone, keep, position, cost: q.quadric_at(position), border })
-    }
-
-    /// Adds to the quadric of each border edge's ends the plane through the edge across its
-    /// face, weighted like one vertex's samples (the mean count of samples per vertex), so a
-    /// border that moves costs as much as a surface that does.
-    fn add_border_planes(&mut self, mesh: &Mesh) {
-        if !self.collapser.has_border() {
-            return; // closed: nothing to sort out
-        }
-        let n = self.quadrics.len().max(1) as f64;
-        let weight = self.quadrics.iter().map(|q| q.count as f64).sum::<f64>() / n;
-        let mut edges: Vec<((u32, u32), u32)> = Vec::new();
-        for (t, tri) in mesh.triangles.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                edges.push(((a.min(b), a.max(b)), t as u32));
-            }
-        }
-        edges.sort_unstable();
-        for (i, &((a, b), t)) in edges.iter().enumerate() {
-            let alone = (i == 0 || edges[i - 1].0 != (a, b)) && edges.get(i + 1).is_none_or(|e| e.0 != (a, b));
-            if !alone {
-                continue;
-            }
-            let [x, y, z] = mesh.triangles[t as usize].map(|v| self.positions[v as usize]);
-            let normal = (y - x).cross(z - x);
-            let (pa, pb) = (self.positions[a as usize], self.positions[b as usize]);
-            let across = (pb - pa).cross(normal).normalize_or_zero();
-            if across == DVec3::ZERO {
-                continue;
-            }
-            let d = across.dot(pa);
-            for v in [a, b] {
-                let q = &mut self.quadrics[v as usize];
-                q.nn.add(&Sym3::outer(across).scaled(weight));
-                q.b += across * (d * weight);
-                q.c += d * d * weight;
-            }
-        }
     }
 
     /// Whether moving the ends of edge gone-keep to `position` would turn a surviving face by
@@ -266,8 +327,7 @@ impl Decimator {
     fn drop_stale(&mut self, faces: usize) {
         if self.heap.len() > STALE_RATIO * faces {
             let versions = &self.versions;
-            self.heap
-                .retain(|c| versions[c.gone as usize] == c.versions[0] && versions[c.keep as usize] == c.versions[1]);
+            self.heap.retain(|c| c.is_current(versions));
         }
     }
 
@@ -294,8 +354,12 @@ mod tests {
     use crate::eval::shapes;
     use crate::topology::analyze;
 
+    fn serial() -> Threads {
+        Threads::new(1).unwrap()
+    }
+
     /// Each vertex's quadric: the planes of its faces (unit normals, as samples would give).
-    fn face_quadrics(mesh: &Mesh) -> Vec<CellStats> {
+    pub(super) fn face_quadrics(mesh: &Mesh) -> Vec<CellStats> {
         let mut q = vec![CellStats::default(); mesh.positions.len()];
         for t in &mesh.triangles {
             let [a, b, c] = t.map(|v| mesh.positions[v as usize].as_dvec3());
@@ -311,7 +375,7 @@ mod tests {
     fn reaches_the_count_and_keeps_the_genus() {
         for (mesh, genus) in [(shapes::icosphere(1.0, 4), 0), (shapes::torus(1.0, 0.3, 64, 32), 1)] {
             for target in [2000, 500, 100] {
-                let (out, kept) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, target);
+                let (out, kept) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, target, &serial());
                 let r = analyze(&out);
                 assert!(r.is_watertight(), "{r:?}");
                 assert_eq!(r.genus(), Some(genus));
@@ -324,11 +388,11 @@ mod tests {
     #[test]
     fn a_sphere_stays_round_and_stops_at_a_tetrahedron() {
         let mesh = shapes::icosphere(1.0, 4);
-        let (out, _) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 200);
+        let (out, _) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 200, &serial());
         for p in &out.positions {
             assert!((p.length() - 1.0).abs() < 0.1, "{p}");
         }
-        let (tiny, _) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 0);
+        let (tiny, _) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 0, &serial());
         assert_eq!(tiny.triangles.len(), 4);
         assert!(analyze(&tiny).is_watertight());
     }
@@ -341,7 +405,7 @@ mod tests {
         let open = Mesh::new(sphere.positions.clone(), None, triangles);
         let before = analyze(&open);
         for target in [300, 60, 10] {
-            let (out, _) = decimate(&open, face_quadrics(&open), DVec3::ZERO, target);
+            let (out, _) = decimate(&open, face_quadrics(&open), DVec3::ZERO, target, &serial());
             let r = analyze(&out);
             assert!(out.triangles.len().abs_diff(target) <= 1, "{} for {target}", out.triangles.len());
             assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.components), (0, 0, 1), "{r:?}");
@@ -353,15 +417,9 @@ mod tests {
     #[test]
     fn stale_candidates_are_dropped_once_they_crowd_the_queue() {
         let mesh = shapes::icosphere(1.0, 2);
-        let n = mesh.positions.len();
-        let mut d = Decimator {
-            collapser: Collapser::new(&mesh),
-            positions: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
-            quadrics: face_quadrics(&mesh),
-            versions: vec![0; n],
-            heap: QuadHeap::new(),
-        };
-        d.seed(&mesh);
+        let positions = mesh.positions.iter().map(|p| p.as_dvec3()).collect();
+        let mut d = Decimator::new(&mesh, positions, face_quadrics(&mesh), None);
+        d.seed();
         let edges = d.heap.len();
         assert_eq!(edges, 3 * mesh.triangles.len() / 2);
         // Under the ratio nothing is dropped; above it, every candidate of a changed vertex.
@@ -389,13 +447,8 @@ mod tests {
         ];
         let triangles = vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]];
         let mesh = Mesh::new(positions, None, triangles);
-        let d = Decimator {
-            collapser: Collapser::new(&mesh),
-            positions: mesh.positions.iter().map(|p| p.as_dvec3()).collect(),
-            quadrics: face_quadrics(&mesh),
-            versions: vec![0; 5],
-            heap: QuadHeap::new(),
-        };
+        let positions = mesh.positions.iter().map(|p| p.as_dvec3()).collect();
+        let d = Decimator::new(&mesh, positions, face_quadrics(&mesh), None);
         // Inside the fan nothing turns; past vertex 4 faces 0-3-4 and 0-4-1 turn over.
         assert!(!d.folds(2, 0, DVec3::new(0.0, 0.5, 0.0)));
         assert!(d.folds(2, 0, DVec3::new(0.0, -2.0, 0.0)));

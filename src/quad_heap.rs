@@ -44,6 +44,16 @@ impl<T: Ord> QuadHeap<T> {
         }
     }
 
+    /// The greatest item.
+    pub(crate) fn peek(&self) -> Option<&T> {
+        self.items.first()
+    }
+
+    /// The items, in no particular order.
+    pub(crate) fn items(&self) -> &[T] {
+        &self.items
+    }
+
     /// The greatest item, removed.
     pub(crate) fn pop(&mut self) -> Option<T> {
         let last = self.items.pop()?;

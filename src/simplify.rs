@@ -404,7 +404,7 @@ fn simplify_to_size(
         want = clusters_for(target, Some((leaves, out.0.triangles.len())), factor);
     };
     progress.report(0.9, "collapsing edges to the size")?;
-    let out = collapse_to_target(out, &out_clusters, &cluster_stats, &tree, target, mesh.origin)?;
+    let out = collapse_to_target(out, &out_clusters, &cluster_stats, &tree, target, mesh.origin, threads)?;
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
         tree: tree.stats(),
@@ -430,10 +430,12 @@ fn collapse_to_target(
     tree: &VsTree,
     target: usize,
     origin: DVec3,
+    threads: &Threads,
 ) -> Result<Mesh> {
     let quadrics = out_clusters.iter().map(|&c| stats[c as usize]).collect();
     let centre = tree.root().center.as_dvec3();
-    let mut out = if out.triangles.len() > target + 1 { decimate(&out, quadrics, centre, target).0 } else { out };
+    let mut out =
+        if out.triangles.len() > target + 1 { decimate(&out, quadrics, centre, target, threads).0 } else { out };
     out.origin = origin;
     if out.triangles.is_empty() {
         return Err(Error::input(format!(
