@@ -71,6 +71,11 @@ impl Chunks {
     }
 }
 
+/// The shift of a second cut's grid (a fraction of the box, see [`morton_chunks`]): far from a
+/// power of two, so the second cut's chunk boundaries, which lie on the grid's power-of-two
+/// planes, miss the first's.
+pub(crate) const SECOND_CUT: f32 = 0.37;
+
 /// The chunk of each of `points` when the points, in Morton order (a curve through space that
 /// keeps nearby points together), are cut into `count` runs of equal length. `shift` moves the
 /// grid the order is taken on (as a fraction of the points' box), so a second cut puts its
@@ -159,7 +164,7 @@ mod tests {
             assert_eq!(on_seam, theirs.len() > 1, "vertex {v}");
         }
         // Shifted, the grid puts the seams elsewhere.
-        let shifted = morton_chunks(&sphere.positions, 8, 0.3);
+        let shifted = morton_chunks(&sphere.positions, 8, SECOND_CUT);
         let again = Chunks::new(&sphere, 8, |v| shifted[v as usize]);
         let both = (0..chunks.seam.len()).filter(|&v| chunks.seam[v] && again.seam[v]).count();
         let first = chunks.seam.iter().filter(|&&s| s).count();

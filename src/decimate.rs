@@ -10,6 +10,7 @@
 
 mod chunks;
 
+use crate::chunks::SECOND_CUT;
 use crate::collapse::Collapser;
 use crate::linalg::Sym3;
 use crate::mesh::Mesh;
@@ -33,7 +34,7 @@ const STALE_RATIO: usize = 3;
 /// Where the grids of the chunked passes lie (a fraction of the mesh's box, see
 /// [`crate::chunks::morton_chunks`]): the second pass, its seams elsewhere, takes what the
 /// first left locked along its seams, in parallel too, so the serial pass has little left.
-const CHUNK_SHIFTS: [f32; 2] = [0.0, 0.37];
+const CHUNK_SHIFTS: [f32; 2] = [0.0, SECOND_CUT];
 
 /// A candidate collapse: `gone` merges into `keep`, for `cost`; `versions` are the two
 /// vertices' versions when it was planned (stale once either changes). Where they meet is

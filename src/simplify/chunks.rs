@@ -27,13 +27,14 @@ pub(super) fn collapse_inside_chunks(
     mesh: &Mesh,
     labels: &[u32],
     representatives: &[Vec3],
+    shift: f32,
 ) -> Option<(Mesh, Vec<u32>)> {
     let chunks = mesh.triangles.len() / CHUNK_TRIANGLES;
     let clusters = representatives.len();
     if chunks < 2 || clusters == 0 {
         return None;
     }
-    let chunk_of_cluster = morton_chunks(representatives, chunks, 0.0);
+    let chunk_of_cluster = morton_chunks(representatives, chunks, shift);
     let parts = Chunks::new(mesh, chunks, |v| chunk_of_cluster[labels[v as usize] as usize]);
     let runs = parts.runs();
     let merged: Vec<(Vec<u32>, Mesh)> =
@@ -83,6 +84,7 @@ fn collapse_chunk(mesh: &Mesh, labels: &[u32], seam: &[bool], triangles: &[u32])
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::chunks::SECOND_CUT;
     use crate::eval::shapes;
     use crate::topology::analyze;
 
@@ -108,7 +110,7 @@ mod tests {
     /// The chunks' pass and then the serial one, as `collapse_keeping_topology` runs them.
     fn both_passes(mesh: &Mesh, cells: f32) -> Mesh {
         let (labels, centres) = grid_clusters(mesh, cells);
-        let (rest, rest_labels) = collapse_inside_chunks(mesh, &labels, &centres).expect("several chunks");
+        let (rest, rest_labels) = collapse_inside_chunks(mesh, &labels, &centres, 0.0).expect("several chunks");
         assert!(
             rest.positions.len() < mesh.positions.len() / 4,
             "{} of {} left",
@@ -139,5 +141,22 @@ mod tests {
         assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.components), (0, 0, 1), "{r:?}");
         assert!(r.boundary_edges >= 6, "{r:?}");
         assert_eq!(r.euler_characteristic, 0, "an annulus: {r:?}");
+    }
+
+    #[test]
+    fn a_second_cut_takes_what_the_first_left_on_its_seams() {
+        // A torus of 1M triangles in small clusters: the first cut's seams leave enough for a
+        // second cut, whose chunks take most of it; genus and closure hold after both.
+        let torus = shapes::torus(1.0, 0.3, 1024, 512);
+        let (labels, centres) = grid_clusters(&torus, 400.0);
+        let (rest, rest_labels) = collapse_inside_chunks(&torus, &labels, &centres, 0.0).expect("chunks");
+        let (again, again_labels) =
+            collapse_inside_chunks(&rest, &rest_labels, &centres, SECOND_CUT).expect("chunks again");
+        let excess = |m: &Mesh| m.positions.len() - centres.len();
+        assert!(excess(&again) < excess(&rest) / 2, "{} then {} beyond one per cluster", excess(&rest), excess(&again));
+        let mut collapser = Collapser::new(&again);
+        collapser.collapse_within(&again_labels);
+        let r = analyze(&collapser.finish(&again_labels).0);
+        assert!(r.is_watertight() && r.genus() == Some(1) && r.components == 1, "{r:?}");
     }
 }

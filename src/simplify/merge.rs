@@ -2,6 +2,7 @@
 //! plainly, re-indexing the triangles to clusters.
 
 use super::{chunks, NO_CLUSTER};
+use crate::chunks::SECOND_CUT;
 use crate::collapse::Collapser;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -29,7 +30,14 @@ pub(super) fn collapse_keeping_topology(
         .copied()
         .collect();
     let proper = Mesh::new(mesh.positions.clone(), None, proper);
-    let (mut out, out_labels) = match threads.run(|| chunks::collapse_inside_chunks(&proper, labels, representatives)) {
+    let first = threads.run(|| chunks::collapse_inside_chunks(&proper, labels, representatives, 0.0));
+    // A second cut, its seams elsewhere, takes most of what the first left along its seams.
+    let second = first.map(|(rest, rest_labels)| {
+        threads
+            .run(|| chunks::collapse_inside_chunks(&rest, &rest_labels, representatives, SECOND_CUT))
+            .unwrap_or((rest, rest_labels))
+    });
+    let (mut out, out_labels) = match second {
         // The seams and borders the chunks left.
         Some((rest, rest_labels)) => {
             let mut collapser = Collapser::new(&rest);
