@@ -12,9 +12,10 @@ mod chunks;
 
 use crate::chunks::SECOND_CUT;
 use crate::collapse::Collapser;
+use crate::error::Result;
 use crate::linalg::Sym3;
 use crate::mesh::Mesh;
-use crate::progress::Threads;
+use crate::progress::{Progress, Threads};
 use crate::quad_heap::QuadHeap;
 use crate::quadric::CellStats;
 use chunks::{decimate_in_chunks, Near};
@@ -115,13 +116,16 @@ pub(crate) fn decimate(
     origin: DVec3,
     target: usize,
     threads: &Threads,
-) -> (Mesh, Vec<u32>) {
+    progress: &mut Progress,
+) -> Result<(Mesh, Vec<u32>)> {
     debug_assert_eq!(quadrics.len(), mesh.positions.len());
     let positions: Vec<DVec3> = mesh.positions.iter().map(|p| p.as_dvec3() - origin).collect();
     add_border_planes(mesh, &positions, &mut quadrics);
     let mut near = Near { mesh: mesh.clone(), positions, quadrics, from: (0..mesh.positions.len() as u32).collect() };
-    for shift in CHUNK_SHIFTS {
-        if let Some(next) = threads.run(|| decimate_in_chunks(&near, target, shift)) {
+    for (pass, shift) in CHUNK_SHIFTS.into_iter().enumerate() {
+        let passes = CHUNK_SHIFTS.len() as f32 + 1.0;
+        let mut stage = progress.stage(pass as f32 / passes, (pass + 1) as f32 / passes);
+        if let Some(next) = decimate_in_chunks(&near, target, shift, threads, &mut stage)? {
             near = next;
         }
     }
@@ -133,7 +137,7 @@ pub(crate) fn decimate(
     for (p, &v) in out.positions.iter_mut().zip(&kept) {
         *p = (d.positions[v as usize] + origin).as_vec3();
     }
-    (out, kept.iter().map(|&v| from[v as usize]).collect())
+    Ok((out, kept.iter().map(|&v| from[v as usize]).collect()))
 }
 
 /// Adds to the quadric of each border edge's ends the plane through the edge across its
@@ -376,7 +380,9 @@ mod tests {
     fn reaches_the_count_and_keeps_the_genus() {
         for (mesh, genus) in [(shapes::icosphere(1.0, 4), 0), (shapes::torus(1.0, 0.3, 64, 32), 1)] {
             for target in [2000, 500, 100] {
-                let (out, kept) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, target, &serial());
+                let (out, kept) =
+                    decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, target, &serial(), &mut Progress::none())
+                        .unwrap();
                 let r = analyze(&out);
                 assert!(r.is_watertight(), "{r:?}");
                 assert_eq!(r.genus(), Some(genus));
@@ -389,11 +395,13 @@ mod tests {
     #[test]
     fn a_sphere_stays_round_and_stops_at_a_tetrahedron() {
         let mesh = shapes::icosphere(1.0, 4);
-        let (out, _) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 200, &serial());
+        let (out, _) =
+            decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 200, &serial(), &mut Progress::none()).unwrap();
         for p in &out.positions {
             assert!((p.length() - 1.0).abs() < 0.1, "{p}");
         }
-        let (tiny, _) = decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 0, &serial());
+        let (tiny, _) =
+            decimate(&mesh, face_quadrics(&mesh), DVec3::ZERO, 0, &serial(), &mut Progress::none()).unwrap();
         assert_eq!(tiny.triangles.len(), 4);
         assert!(analyze(&tiny).is_watertight());
     }
@@ -406,7 +414,8 @@ mod tests {
         let open = Mesh::new(sphere.positions.clone(), None, triangles);
         let before = analyze(&open);
         for target in [300, 60, 10] {
-            let (out, _) = decimate(&open, face_quadrics(&open), DVec3::ZERO, target, &serial());
+            let (out, _) =
+                decimate(&open, face_quadrics(&open), DVec3::ZERO, target, &serial(), &mut Progress::none()).unwrap();
             let r = analyze(&out);
             assert!(out.triangles.len().abs_diff(target) <= 1, "{} for {target}", out.triangles.len());
             assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.components), (0, 0, 1), "{r:?}");

@@ -404,7 +404,10 @@ fn simplify_to_size(
         want = clusters_for(target, Some((leaves, out.0.triangles.len())), factor);
     };
     progress.report(0.9, "collapsing edges to the size")?;
-    let out = collapse_to_target(out, &out_clusters, &cluster_stats, &tree, target, mesh.origin, threads)?;
+    let mut out = out;
+    out.origin = mesh.origin;
+    let out =
+        collapse_to_target(out, &out_clusters, &cluster_stats, &tree, target, threads, &mut progress.stage(0.9, 1.0))?;
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
         tree: tree.stats(),
@@ -421,21 +424,25 @@ fn simplify_to_size(
 }
 
 /// Brings the clustered mesh `out` (vertex v from cluster `out_clusters[v]`, whose sums are
-/// in `stats`, relative to `tree`'s root centre) to `target` triangles by quadric collapses,
-/// and puts it at `origin`; refused when nothing is left.
+/// in `stats`, relative to `tree`'s root centre) to `target` triangles by quadric collapses;
+/// refused when nothing is left. The result is in `out`'s frame, at `out`'s origin.
 fn collapse_to_target(
     out: Mesh,
     out_clusters: &[u32],
     stats: &[CellStats],
     tree: &VsTree,
     target: usize,
-    origin: DVec3,
     threads: &Threads,
+    progress: &mut Progress,
 ) -> Result<Mesh> {
     let quadrics = out_clusters.iter().map(|&c| stats[c as usize]).collect();
     let centre = tree.root().center.as_dvec3();
-    let mut out =
-        if out.triangles.len() > target + 1 { decimate(&out, quadrics, centre, target, threads).0 } else { out };
+    let origin = out.origin;
+    let mut out = if out.triangles.len() > target + 1 {
+        decimate(&out, quadrics, centre, target, threads, progress)?.0
+    } else {
+        out
+    };
     out.origin = origin;
     if out.triangles.is_empty() {
         return Err(Error::input(format!(

@@ -9,7 +9,9 @@
 
 use super::Decimator;
 use crate::chunks::{morton_chunks, submesh, Chunks};
+use crate::error::Result;
 use crate::mesh::Mesh;
+use crate::progress::{Progress, Threads};
 use crate::quadric::CellStats;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -48,56 +50,70 @@ pub(super) struct Near {
 /// the room their seams need, the seams locked; `shift` places the chunks' grid (see
 /// [`morton_chunks`]). The input vertex of each vertex is followed. `None` when the mesh is too
 /// small for more than one chunk, or its seams leave the chunks nothing to do.
-pub(super) fn decimate_in_chunks(near: &Near, target: usize, shift: f32) -> Option<Near> {
+pub(super) fn decimate_in_chunks(
+    near: &Near,
+    target: usize,
+    shift: f32,
+    threads: &Threads,
+    progress: &mut Progress,
+) -> Result<Option<Near>> {
     let Near { mesh, positions, quadrics, from } = near;
     let count = mesh.triangles.len() / CHUNK_TRIANGLES;
     if count < 2 {
-        return None;
+        return Ok(None);
     }
-    let chunk_of = morton_chunks(&mesh.positions, count, shift);
-    let chunks = Chunks::new(mesh, count, |v| chunk_of[v as usize]);
+    let chunk_of = threads.run(|| morton_chunks(&mesh.positions, count, shift));
+    let chunks = threads.run(|| Chunks::new(mesh, count, |v| chunk_of[v as usize]));
     let seams = chunks.triangles(count).len();
     let goal = (target + SEAM_ROOM * seams) as f64;
     if goal >= (mesh.triangles.len() - seams) as f64 {
-        return None;
+        return Ok(None);
     }
-    let mut parts: Vec<(Vec<u32>, Decimator)> = chunks
-        .runs()
-        .par_iter()
-        .map(|run| {
-            let (vertices, sub) = submesh(mesh, run);
-            let locked = vertices.iter().map(|&v| chunks.seam[v as usize]).collect();
-            let sub_positions = vertices.iter().map(|&v| positions[v as usize]).collect();
-            let sub_quadrics = vertices.iter().map(|&v| quadrics[v as usize]).collect();
-            let mut d = Decimator::new(&sub, sub_positions, sub_quadrics, Some(locked));
-            d.seed();
-            (vertices, d)
-        })
-        .collect();
+    let mut parts: Vec<(Vec<u32>, Decimator)> = threads.run(|| {
+        chunks
+            .runs()
+            .par_iter()
+            .map(|run| {
+                let (vertices, sub) = submesh(mesh, run);
+                let locked = vertices.iter().map(|&v| chunks.seam[v as usize]).collect();
+                let sub_positions = vertices.iter().map(|&v| positions[v as usize]).collect();
+                let sub_quadrics = vertices.iter().map(|&v| quadrics[v as usize]).collect();
+                let mut d = Decimator::new(&sub, sub_positions, sub_quadrics, Some(locked));
+                d.seed();
+                (vertices, d)
+            })
+            .collect()
+    });
+    let start = parts.iter().map(|(_, d)| d.faces).sum::<usize>() as f64 - goal;
     loop {
         let faces: usize = parts.iter().map(|(_, d)| d.faces).sum();
         let excess = faces as f64 - goal;
         if excess <= CLOSE_ENOUGH * goal {
             break;
         }
+        progress.report((1.0 - excess / start) as f32, "collapsing edges to the size")?;
         // Two triangles go per collapse.
         let wanted = (excess / 2.0 * ROUND_SHARE).ceil() as usize;
-        let mut costs: Vec<f64> = parts
-            .par_iter()
-            .flat_map_iter(|(_, d)| d.heap.items().iter().filter(|c| c.is_current(&d.versions)).map(|c| c.cost))
-            .collect();
+        let mut costs: Vec<f64> = threads.run(|| {
+            parts
+                .par_iter()
+                .flat_map_iter(|(_, d)| d.heap.items().iter().filter(|c| c.is_current(&d.versions)).map(|c| c.cost))
+                .collect()
+        });
         if costs.is_empty() {
             break;
         }
         let k = wanted.min(costs.len() - 1);
         let (_, &mut cap, _) = costs.select_nth_unstable_by(k, f64::total_cmp);
-        let taken: usize = parts
-            .par_iter_mut()
-            .map(|(_, d)| {
-                let below = d.heap.items().iter().filter(|c| c.cost <= cap && c.is_current(&d.versions)).count();
-                d.take_below(cap, 2 * below)
-            })
-            .sum();
+        let taken: usize = threads.run(|| {
+            parts
+                .par_iter_mut()
+                .map(|(_, d)| {
+                    let below = d.heap.items().iter().filter(|c| c.cost <= cap && c.is_current(&d.versions)).count();
+                    d.take_below(cap, 2 * below)
+                })
+                .sum()
+        });
         if taken == 0 {
             break;
         }
@@ -116,12 +132,12 @@ pub(super) fn decimate_in_chunks(near: &Near, target: usize, shift: f32) -> Opti
         triangles.extend(left.triangles.iter().map(|t| t.map(|v| vertices[kept[v as usize] as usize])));
     }
     let kept = crate::reconstruct::renumber_used_vertices(&mut triangles, positions.len());
-    Some(Near {
+    Ok(Some(Near {
         mesh: Mesh::new(kept.iter().map(|&v| mesh.positions[v]).collect(), None, triangles),
         positions: kept.iter().map(|&v| positions[v]).collect(),
         quadrics: kept.iter().map(|&v| quadrics[v]).collect(),
         from: kept.iter().map(|&v| from[v]).collect(),
-    })
+    }))
 }
 
 impl Decimator {
@@ -146,7 +162,7 @@ mod tests {
     use super::super::{decimate, tests::face_quadrics};
     use super::*;
     use crate::eval::shapes;
-    use crate::progress::Threads;
+    use crate::progress::{Progress, Threads};
     use crate::topology::analyze;
 
     /// The largest distance of `mesh`'s vertices from the torus of radii 1 and 0.3 about z.
@@ -171,14 +187,24 @@ mod tests {
         let torus = shapes::torus(1.0, 0.3, 512, 256);
         let quadrics = face_quadrics(&torus);
         let target = 20_000;
-        let near = decimate_in_chunks(&whole(&torus, &quadrics), target, 0.0).expect("chunks");
+        let near = decimate_in_chunks(
+            &whole(&torus, &quadrics),
+            target,
+            0.0,
+            &Threads::new(2).unwrap(),
+            &mut Progress::none(),
+        )
+        .unwrap()
+        .expect("chunks");
         let left = near.mesh.triangles.len();
         assert!(left > target && left < target * 2, "{left} left for {target}");
         assert_eq!(near.from.len(), near.mesh.positions.len());
         let r = analyze(&near.mesh);
         assert!(r.is_watertight() && r.genus() == Some(1), "{r:?}");
 
-        let (chunked, _) = decimate(&torus, quadrics.clone(), DVec3::ZERO, target, &Threads::new(2).unwrap());
+        let (chunked, _) =
+            decimate(&torus, quadrics.clone(), DVec3::ZERO, target, &Threads::new(2).unwrap(), &mut Progress::none())
+                .unwrap();
         let r = analyze(&chunked);
         assert!(r.is_watertight() && r.genus() == Some(1), "{r:?}");
         assert!(chunked.triangles.len().abs_diff(target) <= 1);
@@ -205,10 +231,40 @@ mod tests {
             }
         }
         let quadrics = face_quadrics(&plate);
-        assert!(decimate_in_chunks(&whole(&plate, &quadrics), 10_000, 0.0).is_some());
-        let (out, _) = decimate(&plate, quadrics, DVec3::ZERO, 10_000, &Threads::new(2).unwrap());
+        assert!(decimate_in_chunks(
+            &whole(&plate, &quadrics),
+            10_000,
+            0.0,
+            &Threads::new(2).unwrap(),
+            &mut Progress::none()
+        )
+        .unwrap()
+        .is_some());
+        let (out, _) =
+            decimate(&plate, quadrics, DVec3::ZERO, 10_000, &Threads::new(2).unwrap(), &mut Progress::none()).unwrap();
         let in_corner = |t: &&[u32; 3]| corner(t.iter().map(|&v| out.positions[v as usize]).sum::<glam::Vec3>() / 3.0);
         let there = out.triangles.iter().filter(in_corner).count();
         assert!(there > out.triangles.len() * 3 / 4, "{there} of {} in the corner", out.triangles.len());
+    }
+
+    #[test]
+    fn the_rounds_report_progress_and_stop_when_cancelled() {
+        let torus = shapes::torus(1.0, 0.3, 512, 256);
+        let quadrics = face_quadrics(&torus);
+        let threads = Threads::new(2).unwrap();
+        let mut seen = Vec::new();
+        let mut record = |fraction: f32, _: &str| {
+            seen.push(fraction);
+            true
+        };
+        decimate(&torus, quadrics.clone(), DVec3::ZERO, 20_000, &threads, &mut Progress::new(&mut record)).unwrap();
+        assert!(seen.len() > 4 && seen.windows(2).all(|w| w[0] <= w[1]), "{seen:?}");
+        let mut calls = 0;
+        let mut cancel = |_: f32, _: &str| {
+            calls += 1;
+            calls < 3
+        };
+        let cancelled = decimate(&torus, quadrics, DVec3::ZERO, 20_000, &threads, &mut Progress::new(&mut cancel));
+        assert!(cancelled.is_err());
     }
 }

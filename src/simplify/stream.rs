@@ -119,7 +119,9 @@ pub fn simplify_ply_streaming(
         round += 1;
     };
     progress.report(0.95, "collapsing edges to the size")?;
-    let out = collapse_to_target(out, &out_clusters, &stats, &tree, target, origin, &threads)?;
+    let mut out = out;
+    out.origin = origin;
+    let out = collapse_to_target(out, &out_clusters, &stats, &tree, target, &threads, &mut progress.stage(0.95, 1.0))?;
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
         tree: tree.stats(),
