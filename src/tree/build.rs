@@ -197,11 +197,11 @@ impl Part<'_> {
 }
 
 /// One subtree of phase 2: the node that roots it, its sums, and the samples it owns.
-struct Job<'a> {
-    index: usize,
-    node: Node,
-    stats: CellStats,
-    samples: &'a mut [TreeSample],
+pub(super) struct Job<'a> {
+    pub(super) index: usize,
+    pub(super) node: Node,
+    pub(super) stats: CellStats,
+    pub(super) samples: &'a mut [TreeSample],
 }
 
 #[derive(Clone, Copy)]
@@ -422,7 +422,7 @@ fn add_children(
 }
 
 /// Splits `samples` into the disjoint ranges of the given nodes (sorted by start).
-fn carve(samples: &mut [TreeSample], nodes: impl Iterator<Item = (usize, Node, CellStats)>) -> Vec<Job<'_>> {
+pub(super) fn carve(samples: &mut [TreeSample], nodes: impl Iterator<Item = (usize, Node, CellStats)>) -> Vec<Job<'_>> {
     let mut rest = samples;
     let mut consumed = 0usize;
     let mut jobs = Vec::new();
@@ -439,7 +439,7 @@ fn carve(samples: &mut [TreeSample], nodes: impl Iterator<Item = (usize, Node, C
 
 /// Appends a part built in phase 2 under node `i`: its local node 0 replaces node `i`, the
 /// others are appended with their indices shifted; local frames likewise.
-fn append_part(
+pub(super) fn append_part(
     nodes: &mut Vec<Node>,
     frames: &mut Vec<Frame>,
     i: usize,
