@@ -13,8 +13,11 @@
 //! ```text
 //! cargo bench --bench simplify -- [--ratios 0.02,0.005] [--runs N] [--models a,b]
 //!     [--data ../shared/data] [--curve igea,camel] [--curve-ratios ...] [--peers a,b]
-//!     [--large 3.5M,14M,50M] [--stream 14M,50M,200M] [--no-write]
+//!     [--large 3.5M,14M,50M] [--stream 14M,50M,200M] [--meshlab-max 5000000] [--no-write]
 //! ```
+//!
+//! Besides the error against size of the `--curve` models, it draws the time against the
+//! input's size of every method at the first ratio over every model (`simplify-time-size.png`).
 //!
 //! With `--stream`, the `vstree` command also simplifies generated tori of those sizes, and the
 //! `--large` inputs' files, streamed and read whole, for time and peak memory (`stream.rs`);
@@ -45,7 +48,7 @@ usage: cargo bench --bench simplify -- [options]
   --data DIR          data directory (default ../shared/data, relative to the project root;
                       its corpus/ folder too)
   --curve A,B         models whose error is measured over a range of sizes and plotted
-                      (default igea,camel; or none)
+                      (default igea,camel; or none; a --large size, 14M, names its mesh)
   --curve-ratios A,B  the sizes of the curve (default 0.0025,0.005,0.01,0.02,0.05,0.1)
   --threads N         vstree's worker threads, 0 = all cores (default 0)
   --peers A,B         only these peers (default all: meshopt-simplify, meshopt-sloppy,
@@ -56,11 +59,18 @@ usage: cargo bench --bench simplify -- [options]
   --stream A,B        also stream generated bumpy tori of these sizes (14M, 50M, 200M triangles,
                       kept under target/bench-simplify/stream/) and the --large inputs' files
                       through the vstree command, for time and peak memory
+  --meshlab-max N     PyMeshLab's methods only on inputs of at most N triangles (default
+                      5000000: above, its clustering's search for the cell size takes minutes
+                      per size)
   --no-write          print the report only: do not update docs/benchmarks.md or the plots";
 
 /// The peers `benches/peers.py` runs, in the order the table shows them.
 const PEERS: [&str; 5] =
     ["meshopt-simplify", "meshopt-sloppy", "fast-simplification", "meshlab-qec", "meshlab-clustering"];
+
+/// PyMeshLab's methods: its quadric edge collapse is 17-36x slower than meshoptimizer, its
+/// clustering's cell size is searched for by bisection, one run per step.
+const MESHLAB: [&str; 2] = [PEERS[3], PEERS[4]];
 
 /// vstree's methods: name, tree, whether the topology is kept.
 pub const VSTREE: [(&str, TreeKind, KeepTopology); 3] = [
@@ -88,6 +98,7 @@ struct Options {
     peers: Vec<String>,
     large: Vec<String>,
     stream: Vec<String>,
+    meshlab_max: usize,
     write: bool,
 }
 
@@ -104,6 +115,7 @@ impl Options {
             peers: PEERS.iter().map(|p| p.to_string()).collect(),
             large: Vec::new(),
             stream: Vec::new(),
+            meshlab_max: 5_000_000,
             write: true,
         };
         let mut it = args.iter();
@@ -129,12 +141,16 @@ impl Options {
                 }
                 "--large" => o.large = names(value()?),
                 "--stream" => o.stream = names(value()?),
+                "--meshlab-max" => o.meshlab_max = number(value()?)?,
                 "--no-write" => o.write = false,
                 other => return Err(format!("unknown option {other}\n{USAGE}")),
             }
         }
         if o.runs == 0 {
             return Err("--runs must be at least 1".into());
+        }
+        if o.ratios.is_empty() {
+            return Err("--ratios needs at least one ratio".into());
         }
         if o.ratios.iter().chain(&o.curve_ratios).any(|&r| !(r > 0.0 && r <= 1.0)) {
             return Err("ratios must be in (0, 1]".into());
@@ -153,8 +169,8 @@ fn main() {
     if !only_stream {
         let report = common::cli::or_fail("simplify", run(&options, &root, command.clone()));
         common::report::publish(&root, "simplify", &report.markdown(), options.write);
-        if options.write && !report.curve.is_empty() {
-            plot(&root, &report);
+        if options.write {
+            plot(&root, &report, options.ratios[0]);
         }
     }
     if !options.stream.is_empty() {
@@ -183,6 +199,8 @@ fn streamed(o: &Options, root: &Path, command: String) -> Result<String, String>
 /// One input: a triangle mesh read from the data directory.
 struct Input {
     name: String,
+    /// The `--large` size it was generated at (`14M`), for the others `None`.
+    size: Option<String>,
     path: PathBuf,
     mesh: Mesh,
     /// The input's vertices (those triangles use), measured to every output.
@@ -218,18 +236,18 @@ fn inputs(data: &Path, only: Option<&[String]>) -> Vec<Input> {
                     continue;
                 }
             };
-            inputs.extend(input(name, path, mesh));
+            inputs.extend(input(name, None, path, mesh));
         }
     }
     inputs
 }
 
 /// `mesh`, read from `path`, as an input: `None` if it has no triangle to sample.
-fn input(name: String, path: PathBuf, mesh: Mesh) -> Option<Input> {
+fn input(name: String, size: Option<String>, path: PathBuf, mesh: Mesh) -> Option<Input> {
     let samples = SampleSet::from_mesh(&mesh, MeshSampling::Vertices).ok()?;
     let diagonal = vstree::Aabb::of(&samples.positions).map_or(1.0, |b| b.diagonal());
     let genus = analyze(&mesh).genus();
-    Some(Input { name, path, mesh, points: samples.positions, diagonal, genus })
+    Some(Input { name, size, path, mesh, points: samples.positions, diagonal, genus })
 }
 
 /// The triangle count for `ratio` of `input`'s.
@@ -314,13 +332,13 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     for size in &o.large {
         eprintln!("simplify: the {size} input (generated on first use)");
         let (name, path, mesh) = large::mesh(size, &o.data, &out_dir.join("large"))?;
-        inputs.extend(input(name, path, mesh));
+        inputs.extend(input(name, Some(size.clone()), path, mesh));
     }
     if inputs.is_empty() {
         return Err(format!("no triangle mesh in {}", shown(&o.data, root)));
     }
     for (index, input) in inputs.iter().enumerate() {
-        let on_curve = o.curve.contains(&input.name);
+        let on_curve = o.curve.iter().any(|c| *c == input.name || Some(c) == input.size.as_ref());
         let mut ratios = o.ratios.clone();
         if on_curve {
             ratios.extend(&o.curve_ratios);
@@ -348,10 +366,16 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
                 measured.push(row(input, ratio, STREAMED, seconds, None, &out));
             }
         }
-        if !o.peers.is_empty() {
+        let mut peer_methods = o.peers.clone();
+        if input.mesh.triangles.len() > o.meshlab_max && peer_methods.iter().any(|p| MESHLAB.contains(&p.as_str())) {
+            peer_methods.retain(|p| !MESHLAB.contains(&p.as_str()));
+            notes
+                .push(format!("PyMeshLab not run on {} (over --meshlab-max {} triangles).", input.name, o.meshlab_max));
+        }
+        if !peer_methods.is_empty() {
             let mut targets: Vec<usize> = ratios.iter().map(|&r| target(input, r)).collect();
             targets.dedup();
-            match peers(root, &out_dir, input, &targets, &o.peers, o.runs) {
+            match peers(root, &out_dir, input, &targets, &peer_methods, o.runs) {
                 Ok(runs) => {
                     for r in runs {
                         let Some(&ratio) = ratios.iter().find(|&&x| target(input, x) == r.target) else { continue };
@@ -431,14 +455,15 @@ fn peers(
         .collect())
 }
 
-/// Writes the curve's rows to `target/bench-simplify/curve.tsv` and has
-/// `benches/simplify_plot.py` draw one PNG per model into `docs/images/`.
-fn plot(root: &Path, report: &Report) {
-    let path = root.join("target").join("bench-simplify").join("curve.tsv");
-    let mut tsv = String::from("model\tmethod\tratio\ttriangles\tchamfer\thausdorff\tseconds\n");
+/// Writes the curve's rows to `target/bench-simplify/curve.tsv` and every model's times at the
+/// first ratio to `times.tsv` beside it, and has `benches/simplify_plot.py` draw one PNG of
+/// error against size per curve model and one of time against input size into `docs/images/`.
+fn plot(root: &Path, report: &Report, first_ratio: f64) {
+    let dir = root.join("target").join("bench-simplify");
+    let mut curve = String::from("model\tmethod\tratio\ttriangles\tchamfer\thausdorff\tseconds\n");
     for r in &report.curve {
         let d: Distances = r.distances;
-        tsv.push_str(&format!(
+        curve.push_str(&format!(
             "{}\t{}\t{}\t{}\t{}\t{}\t{}\n",
             r.input,
             r.method,
@@ -449,11 +474,24 @@ fn plot(root: &Path, report: &Report) {
             r.seconds
         ));
     }
-    if let Err(e) = std::fs::create_dir_all(path.parent().unwrap_or(root)).and_then(|()| std::fs::write(&path, tsv)) {
-        eprintln!("simplify: cannot write {}: {e}", path.display());
+    let mut times = String::from("model\tmethod\tratio\tinput_triangles\tseconds\n");
+    for r in report.rows.iter().filter(|r| r.ratio == first_ratio) {
+        let (model, n, ratio) = (&r.input, r.input_triangles, r.ratio);
+        times.push_str(&format!("{model}\t{}\t{ratio}\t{n}\t{}\n", r.method, r.seconds));
+        if let Some(one) = r.seconds_one_thread {
+            times.push_str(&format!("{model}\t{} (1 thread)\t{ratio}\t{n}\t{one}\n", r.method));
+        }
+    }
+    let (curve_path, times_path) = (dir.join("curve.tsv"), dir.join("times.tsv"));
+    let written = std::fs::create_dir_all(&dir)
+        .and_then(|()| std::fs::write(&curve_path, curve))
+        .and_then(|()| std::fs::write(&times_path, times));
+    if let Err(e) = written {
+        eprintln!("simplify: cannot write under {}: {e}", dir.display());
         return;
     }
-    let args: Vec<std::ffi::OsString> = vec![path.into(), root.join("docs").join("images").into()];
+    let args: Vec<std::ffi::OsString> =
+        vec![curve_path.into(), times_path.into(), root.join("docs").join("images").into()];
     match common::peers::run(root, "simplify_plot.py", &args) {
         Ok(records) => {
             for r in records {

@@ -106,11 +106,11 @@ impl Report {
         let mut md = c.run.header();
         let _ = writeln!(
             md,
-            "- Times: median of {} runs of the call alone, the mesh already in memory, in process; vstree on {} \
+            "- Times: {} of the call alone, the mesh already in memory, in process; vstree on {} \
              (the new mode also on one thread), the peers on one. Distances: `vstree::eval::distance`, relative to the \
              input's bounding-box diagonal; Chamfer = mean of the two one-sided mean distances (200k points on the \
              output, the input's vertices), Hausdorff = the larger one-sided maximum.",
-            c.runs,
+            if c.runs == 1 { "one run".to_string() } else { format!("median of {} runs", c.runs) },
             c.run.threads_text(" threads"),
         );
         c.run.write_notes(&mut md);
