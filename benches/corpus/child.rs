@@ -24,15 +24,24 @@ pub struct VstreeRun {
     pub memory: Peak,
 }
 
-/// Runs the child on the cloud in `cloud`, `runs` timed runs, and writes its output to `output`.
-pub fn run(cloud: &Path, output: &Path, runs: usize, threads: usize, base_mesh: &str) -> Result<VstreeRun, String> {
+/// What the child is asked: timed runs, threads, the base mesh's name, the target distance.
+pub struct Asked<'a> {
+    pub runs: usize,
+    pub threads: usize,
+    pub base_mesh: &'a str,
+    pub target: f64,
+}
+
+/// Runs the child on the cloud in `cloud` as `asked`, and writes its output to `output`.
+pub fn run(cloud: &Path, output: &Path, asked: &Asked) -> Result<VstreeRun, String> {
     let args = [
         "--vstree-child".to_string(),
         cloud.display().to_string(),
         output.display().to_string(),
-        runs.to_string(),
-        threads.to_string(),
-        base_mesh.to_string(),
+        asked.runs.to_string(),
+        asked.threads.to_string(),
+        asked.base_mesh.to_string(),
+        asked.target.to_string(),
     ];
     let (memory, stdout) = run_child_output(&args, false)?;
     if let Some(why) = stdout.lines().find_map(|l| l.strip_prefix("failed\t")) {
@@ -60,7 +69,7 @@ pub fn run(cloud: &Path, output: &Path, runs: usize, threads: usize, base_mesh: 
     })
 }
 
-/// The child's side: `<cloud> <output> <runs> <threads> <base mesh>`. Prints the memory report
+/// The child's side: `<cloud> <output> <runs> <threads> <base mesh> <target distance>`. Prints the memory report
 /// and the record, or why it failed (on stderr too, for a failure before the memory report).
 pub fn child(args: &[String]) {
     match reconstruct_file(args) {
@@ -74,13 +83,15 @@ pub fn child(args: &[String]) {
 
 fn reconstruct_file(args: &[String]) -> Result<String, String> {
     let bad = || format!("the child's arguments: {}", args.join(" "));
-    let [cloud, output, runs, threads, base] = args else { return Err(bad()) };
-    let (Ok(runs), Ok(threads), Some(base_mesh)) = (runs.parse(), threads.parse(), crate::base_mesh(base)) else {
+    let [cloud, output, runs, threads, base, target] = args else { return Err(bad()) };
+    let (Ok(runs), Ok(threads), Some(base_mesh), Ok(target_distance)) =
+        (runs.parse(), threads.parse(), crate::base_mesh(base), target.parse())
+    else {
         return Err(bad());
     };
     let cloud = io::read(Path::new(cloud)).map_err(|e| format!("cannot read the cloud: {e}"))?;
     // Defaults on every input: open or closed is found, not told.
-    let params = ReconstructParams { threads, base_mesh, ..ReconstructParams::default() };
+    let params = ReconstructParams { threads, base_mesh, target_distance, ..ReconstructParams::default() };
     let probe = Probe::start();
     let result = reconstruction(&cloud, &params, runs);
     probe.report();

@@ -11,7 +11,7 @@
 //! ```text
 //! cargo bench --bench corpus -- [--peers] [--sizes 200000,1000000] [--models bear,igea] [--quick]
 //!     [--reduced] [--no-synthetic] [--methods open3d-poisson8] [--runs N] [--peer-runs N]
-//!     [--max-peer-points N] [--data ../shared/data] [--threads N] [--base-mesh NAME] [--clouds]
+//!     [--max-peer-points N] [--data ../shared/data] [--threads N] [--base-mesh NAME] [--target-distance X] [--clouds]
 //!     [--no-write]
 //! ```
 //!
@@ -59,6 +59,8 @@ usage: cargo bench --bench corpus -- [options]
   --max-peer-points N   skip the peers on clouds with more points (default 2000000)
   --data DIR            data directory (default ../shared/data, relative to the project root)
   --threads N           vstree's worker threads, 0 = all cores (default 0)
+  --target-distance X   vstree's target distance (a fraction of the diagonal; default: the
+                        library's)
   --base-mesh NAME      vstree's base mesh (default: the library's default); an unknown name lists
                         the names
   --clouds              keep each input cloud (target/bench-corpus/<row>-cloud.ply), to rerun
@@ -113,6 +115,7 @@ pub struct Options {
     write: bool,
     clouds: bool,
     base_mesh: BaseMesh,
+    target_distance: f64,
 }
 
 impl Options {
@@ -135,6 +138,7 @@ impl Options {
             write: true,
             clouds: false,
             base_mesh: BaseMesh::default(),
+            target_distance: ReconstructParams::default().target_distance,
         };
         let mut sizes_given = false;
         let mut it = args.iter();
@@ -163,6 +167,7 @@ impl Options {
                 "--max-peer-points" => o.max_peer_points = number(value()?)?,
                 "--threads" => o.threads = number(value()?)?,
                 "--data" => o.data = PathBuf::from(value()?),
+                "--target-distance" => o.target_distance = number(value()?)?,
                 "--base-mesh" => {
                     let v = value()?;
                     o.base_mesh = base_mesh(v).ok_or_else(|| {
@@ -303,6 +308,9 @@ fn run(o: &Options, root: &Path, command: String) -> Result<Report, String> {
     let (name, what) = base_mesh_name(o.base_mesh);
     let default = if o.base_mesh == BaseMesh::default() { ", the library's default" } else { "" };
     bench.notes.push(format!("vstree's base mesh: `--base-mesh {name}`{default}: {what}."));
+    if o.target_distance != ReconstructParams::default().target_distance {
+        bench.notes.push(format!("vstree's target distance: {} of the diagonal.", o.target_distance));
+    }
 
     let mut skipped = Vec::new();
     for model in &models {
@@ -419,7 +427,10 @@ impl Bench<'_> {
         let output = self.out_dir.join(format!("{stem}-vstree.ply"));
         let base_mesh = base_mesh_name(self.o.base_mesh).0;
         let vstree = written
-            .and_then(|()| child::run(&cloud_path, &output, self.o.runs, self.o.threads, base_mesh))
+            .and_then(|()| {
+                let asked = child::Asked { runs: self.o.runs, threads: self.o.threads, base_mesh, target: self.o.target_distance };
+                child::run(&cloud_path, &output, &asked)
+            })
             .and_then(|run| {
                 let mesh = io::read(&output).map_err(|e| format!("cannot read vstree's output: {e}"))?;
                 let q = quality(&inputs::local(&mesh, case.offset), case.truth, samples.as_ref());
