@@ -129,15 +129,10 @@ pub fn build_allowing_noise(
             batch
                 .into_par_iter()
                 .map(|job| {
-                    let mut part = Part {
-                        nodes: vec![job.node],
-                        frames: Vec::new(),
-                        shared_frames: shared,
-                        samples: job.samples,
-                        sample_base: job.node.start,
-                    };
-                    builder.grow(&mut part, (0, job.stats), None);
-                    (job.index, part.nodes, part.frames)
+                    let (index, stats) = (job.index, job.stats);
+                    let mut part = job.into_part(shared);
+                    builder.grow(&mut part, (0, stats), None);
+                    (index, part.nodes, part.frames)
                 })
                 .collect::<Vec<_>>()
         }));
@@ -280,7 +275,16 @@ impl Builder {
     /// The node's error ([`Metric::cell_error`], allowing for the noise) in the units of
     /// [`Builder::threshold`].
     pub(super) fn error(&self, part: &Part, node: &Node, stats: &CellStats) -> f64 {
-        let frame = (node.kind == NodeKind::Surface).then(|| part.frame(node.frame));
+        self.error_with(node, |f| part.frame(f), stats)
+    }
+
+    /// [`Builder::error`] of a node of a whole tree, whose frames are all in `frames`.
+    pub(super) fn error_among(&self, frames: &[Frame], node: &Node, stats: &CellStats) -> f64 {
+        self.error_with(node, |f| &frames[f as usize], stats)
+    }
+
+    fn error_with<'f>(&self, node: &Node, frame_of: impl Fn(u32) -> &'f Frame, stats: &CellStats) -> f64 {
+        let frame = (node.kind == NodeKind::Surface).then(|| frame_of(node.frame));
         self.params.metric.cell_error(node, frame, stats, self.origin, self.noise)
     }
 
@@ -419,6 +423,20 @@ fn add_children(
     n.first_child = first as u32;
     n.child_count = children.len() as u8;
     children
+}
+
+impl<'a> Job<'a> {
+    /// The part of the tree this job grows: its root node alone over its own samples, frames
+    /// numbered after `shared`.
+    pub(super) fn into_part(self, shared: &'a [Frame]) -> Part<'a> {
+        Part {
+            nodes: vec![self.node],
+            frames: Vec::new(),
+            shared_frames: shared,
+            samples: self.samples,
+            sample_base: self.node.start,
+        }
+    }
 }
 
 /// Splits `samples` into the disjoint ranges of the given nodes (sorted by start).

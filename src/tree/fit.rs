@@ -76,14 +76,8 @@ fn fit_in_batches(tree: &mut VsTree, leaves: usize, threads: &Threads, per_node:
     let mut nodes = std::mem::take(&mut tree.nodes);
     let mut frames = std::mem::take(&mut tree.frames);
     let samples: &mut [TreeSample] = &mut tree.samples;
-    // A node's error: its frame (if it has one) is among `frames`.
-    let error = |nodes: &[Node], frames: &[Frame], i: usize, stats: &CellStats| {
-        let part =
-            Part { nodes: Vec::new(), frames: Vec::new(), shared_frames: frames, samples: &mut [], sample_base: 0 };
-        builder.error(&part, &nodes[i], stats)
-    };
     let mut queue = BinaryHeap::new();
-    queue.push(Queued { error: error(&nodes, &frames, 0, &stats[0]), node: 0 });
+    queue.push(Queued { error: builder.error_among(&frames, &nodes[0], &stats[0]), node: 0 });
     let mut count = 1usize;
     let mut kept = 0usize; // leaves that cannot be split: out of the queue, still leaves
     while count < leaves {
@@ -116,7 +110,7 @@ fn fit_in_batches(tree: &mut VsTree, leaves: usize, threads: &Threads, per_node:
             expanded[i] = true;
             count += children.len() - 1;
             for c in children {
-                queue.push(Queued { error: error(&nodes, &frames, c, &stats[c]), node: c as u32 });
+                queue.push(Queued { error: builder.error_among(&frames, &nodes[c], &stats[c]), node: c as u32 });
             }
         }
     }
@@ -145,20 +139,15 @@ fn split_in_parallel(
     let parts: Vec<_> = threads.run(|| {
         jobs.into_par_iter()
             .map(|job| {
-                let mut part = Part {
-                    nodes: vec![job.node],
-                    frames: Vec::new(),
-                    shared_frames: shared,
-                    samples: job.samples,
-                    sample_base: job.node.start,
-                };
+                let index = job.index;
+                let mut part = job.into_part(shared);
                 let children = builder.split(&mut part, 0, None);
                 let mut sums = Vec::with_capacity(children.len());
                 for (c, s) in children {
                     builder.classify(&mut part, c, &s);
                     sums.push(s);
                 }
-                (job.index, part.nodes, part.frames, sums)
+                (index, part.nodes, part.frames, sums)
             })
             .collect()
     });
