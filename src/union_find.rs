@@ -2,6 +2,8 @@
 //! the others of its set: plain connectivity (mesh components, vertex fans) ignores the signs,
 //! normal orientation uses them to make every normal of a set agree.
 
+use std::sync::atomic::{AtomicU32, Ordering};
+
 /// Union-find (union by rank, path compression) where every element also records whether its
 /// sign is opposite to its parent's. Parent and sign share one word, so a step up the tree is
 /// one memory access; that limits it to fewer than 2^31 elements.
@@ -73,6 +75,58 @@ impl UnionFind {
     }
 }
 
+/// Union-find without signs that many threads join into at once (lock-free: a root is linked
+/// by compare-and-swap, paths are halved as they are walked). The sets it ends with do not
+/// depend on the order of the joins; which element is a set's root does.
+pub(crate) struct SharedUnionFind {
+    parent: Vec<AtomicU32>,
+}
+
+impl SharedUnionFind {
+    /// `n` (below 2^32) single elements.
+    pub fn new(n: usize) -> SharedUnionFind {
+        assert!(n <= u32::MAX as usize, "{n} elements: union-find holds fewer than 2^32");
+        SharedUnionFind { parent: (0..n as u32).map(AtomicU32::new).collect() }
+    }
+
+    /// The current root of `x`'s set.
+    pub fn find(&self, mut x: u32) -> u32 {
+        loop {
+            let parent = self.parent[x as usize].load(Ordering::Relaxed);
+            if parent == x {
+                return x;
+            }
+            let grandparent = self.parent[parent as usize].load(Ordering::Relaxed);
+            if grandparent != parent {
+                // Halving: a failed swap only means another thread moved x's link on first.
+                let _ =
+                    self.parent[x as usize].compare_exchange(parent, grandparent, Ordering::Relaxed, Ordering::Relaxed);
+            }
+            x = parent;
+        }
+    }
+
+    /// Joins the sets of `a` and `b` (the larger root index is linked under the smaller).
+    pub fn union(&self, a: u32, b: u32) {
+        let (mut a, mut b) = (a, b);
+        loop {
+            (a, b) = (self.find(a), self.find(b));
+            if a == b {
+                return;
+            }
+            let (low, high) = (a.min(b), a.max(b));
+            if self.parent[high as usize].compare_exchange(high, low, Ordering::Relaxed, Ordering::Relaxed).is_ok() {
+                return;
+            }
+        }
+    }
+
+    /// Whether `x` is the root of its set (once the joins are over, one element per set is).
+    pub fn is_root(&self, x: u32) -> bool {
+        self.parent[x as usize].load(Ordering::Relaxed) == x
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -91,6 +145,28 @@ mod tests {
         let signs: Vec<bool> = (0..5).map(|x| sign(&mut sets, x)).collect();
         assert_eq!(signs, [false, true, false, false, true]);
         assert_ne!(sets.find(5), sets.find(0));
+    }
+
+    #[test]
+    fn shared_joins_from_many_threads_give_the_sets_of_one() {
+        use rayon::prelude::*;
+        let mut rng = Rng::new(11);
+        let n = 20_000u32;
+        let pairs: Vec<(u32, u32)> =
+            (0..15_000).map(|_| ((rng.next_u64() % n as u64) as u32, (rng.next_u64() % n as u64) as u32)).collect();
+        let shared = SharedUnionFind::new(n as usize);
+        pairs.par_iter().for_each(|&(a, b)| shared.union(a, b));
+        let mut serial = UnionFind::new(n as usize);
+        pairs.iter().for_each(|&(a, b)| {
+            serial.union(a, b);
+        });
+        let roots = (0..n).filter(|&x| shared.is_root(x)).count();
+        let serial_roots = (0..n).filter(|&x| serial.find(x) == x).count();
+        assert_eq!(roots, serial_roots);
+        for x in (0..n).step_by(7) {
+            let y = (x * 31 + 5) % n;
+            assert_eq!(shared.find(x) == shared.find(y), serial.find(x) == serial.find(y), "{x} and {y}");
+        }
     }
 
     /// Random unions against a naive labelling that relabels (and re-signs) a whole set on

@@ -143,6 +143,13 @@ pub fn bumpy_radius(direction: Vec3, radius: f32, amplitude: f32, frequency: f32
     radius * (1.0 + amplitude * d.x.sin() * d.y.sin() * d.z.sin())
 }
 
+/// The triangles of `mesh` with every vertex at z >= 0, on all its vertices: the upper half
+/// of a torus around the z axis is an open band with two border loops.
+pub fn upper_half(mesh: &Mesh) -> Mesh {
+    let upper = mesh.triangles.iter().copied().filter(|t| t.iter().all(|&v| mesh.positions[v as usize].z >= 0.0));
+    Mesh::new(mesh.positions.clone(), None, upper.collect())
+}
+
 /// A sphere with sinusoidal bumps (see [`bumpy_radius`] for the exact surface): an
 /// [`icosphere`] whose vertices are moved radially onto the bumpy surface. Its curvature varies
 /// smoothly over the surface, which is what adaptivity tests need. Genus 0; normals are

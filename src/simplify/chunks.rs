@@ -129,13 +129,7 @@ mod tests {
         let torus = shapes::torus(1.0, 0.3, 512, 256);
         let r = analyze(&both_passes(&torus, 40.0));
         assert!(r.is_watertight() && r.genus() == Some(1) && r.components == 1, "{r:?}");
-        let upper: Vec<[u32; 3]> = torus
-            .triangles
-            .iter()
-            .copied()
-            .filter(|t| t.iter().all(|&v| torus.positions[v as usize].z >= 0.0))
-            .collect();
-        let band = Mesh::new(torus.positions.clone(), None, upper);
+        let band = shapes::upper_half(&torus);
         assert!(band.triangles.len() >= 2 * CHUNK_TRIANGLES);
         let r = analyze(&both_passes(&band, 40.0));
         assert_eq!((r.non_manifold_edges, r.non_manifold_vertices, r.components), (0, 0, 1), "{r:?}");

@@ -1,7 +1,7 @@
-//! Merging each cluster's vertices into one: by edge collapses that keep the topology, or
-//! plainly, re-indexing the triangles to clusters.
+//! Merging each cluster's vertices into one: keeping the topology (disk clusters by
+//! relabelling, the rest by edge collapses), or plainly, re-indexing the triangles to clusters.
 
-use super::{chunks, NO_CLUSTER};
+use super::{chunks, contract, NO_CLUSTER};
 use crate::chunks::SECOND_CUT;
 use crate::collapse::Collapser;
 use crate::error::{Error, Result};
@@ -11,15 +11,18 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 /// Merges each cluster's vertices by edge collapses that keep the topology (see
-/// [`SimplifyParams::keep_topology`]): inside chunks of clusters in parallel
-/// ([`chunks::collapse_inside_chunks`]), then serially along the chunks' seams. A cluster left
+/// [`SimplifyParams::keep_topology`]): on an `edge_manifold` mesh the clusters that are disks
+/// first by relabelling ([`contract::contract_disk_clusters`]); then the rest inside chunks of
+/// clusters in parallel ([`chunks::collapse_inside_chunks`]), and serially along the chunks'
+/// seams. A cluster left
 /// with one vertex puts it at the cluster's representative; a cluster kept in pieces leaves each
 /// at the mean of what it absorbed.
 /// Returns the mesh and the cluster of each of its vertices.
-pub(super) fn collapse_keeping_topology(
+pub(in crate::simplify) fn collapse_keeping_topology(
     mesh: &Mesh,
     labels: &[u32],
     representatives: &[Vec3],
+    edge_manifold: bool,
     threads: &Threads,
 ) -> (Mesh, Vec<u32>) {
     // Degenerate triangles, and those with a vertex in no cluster, take no part.
@@ -30,6 +33,11 @@ pub(super) fn collapse_keeping_topology(
         .copied()
         .collect();
     let proper = Mesh::new(mesh.positions.clone(), None, proper);
+    let contracted = edge_manifold
+        .then(|| threads.run(|| contract::contract_disk_clusters(&proper, labels, representatives)))
+        .flatten();
+    let (proper, labels) = contracted.unwrap_or_else(|| (proper, labels.to_vec()));
+    let labels = labels.as_slice();
     let first = threads.run(|| chunks::collapse_inside_chunks(&proper, labels, representatives, 0.0));
     // A second cut, its seams elsewhere, takes most of what the first left along its seams.
     let second = first.map(|(rest, rest_labels)| {
@@ -45,7 +53,7 @@ pub(super) fn collapse_keeping_topology(
             collapser.finish(&rest_labels)
         }
         None => {
-            let mut used = vec![false; mesh.positions.len()];
+            let mut used = vec![false; proper.positions.len()];
             for &v in proper.triangles.iter().flatten() {
                 used[v as usize] = true;
             }

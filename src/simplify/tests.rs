@@ -46,7 +46,15 @@ fn collapses_from_more_clusters_follow_a_torus_closer() {
     let params = SimplifyParams { target_faces: 300, keep_topology: KeepTopology::On, ..Default::default() };
     let threads = Threads::new(1).unwrap();
     let distance = |factor| {
-        let (out, _) = simplify_to_size(&torus, &params, true, factor, &threads, &mut Progress::none()).unwrap();
+        let (out, _) = simplify_to_size(
+            &torus,
+            &params,
+            Merge::KeepTopology { edge_manifold: true },
+            factor,
+            &threads,
+            &mut Progress::none(),
+        )
+        .unwrap();
         assert!(out.triangles.len().abs_diff(300) <= 1);
         assert_eq!(analyze(&out).genus(), Some(1));
         let on_output = crate::eval::shapes::sample_surface(&out, 20_000, 1).positions;
@@ -69,7 +77,8 @@ fn one_round_suffices_on_closed_shapes() {
         tree::fit(&mut tree, clusters_for(target, None, 1.0), &threads);
         let clusters = cluster(&tree, &threads);
         let labels = vertex_labels(&mesh, &samples, &clusters, MeshSampling::Vertices, &tree);
-        let (kept, _) = collapse_keeping_topology(&mesh, &labels, &clusters.representatives, &Threads::new(0).unwrap());
+        let (kept, _) =
+            collapse_keeping_topology(&mesh, &labels, &clusters.representatives, true, &Threads::new(0).unwrap());
         let (plain, _) = collapse(&mesh, &labels, &clusters.representatives, &threads).unwrap();
         for out in [kept, plain] {
             let n = out.triangles.len();
