@@ -16,7 +16,7 @@ use crate::rng::mix64;
 use crate::union_find::SharedUnionFind;
 use glam::Vec3;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, AtomicUsize, Ordering};
 
 /// Contracts, in `mesh` (an edge-manifold mesh without degenerate triangles, every vertex of a
 /// triangle in a cluster of `labels`), every cluster the module's rules allow to its
@@ -35,39 +35,45 @@ pub(super) fn contract_disk_clusters(
     let border = border_vertices(mesh);
     let labels = &join_stray_pieces(mesh, labels, clusters);
     let mut contract = disk_clusters(mesh, labels, &border, clusters);
-    // The fans to check: all, then those that the last refusals changed.
-    let mut dirty: Option<Vec<bool>> = None;
-    loop {
-        let image = |v: u32| {
-            let c = labels[v as usize];
-            if contract[c as usize] {
-                c
-            } else {
-                clusters as u32 + v
-            }
-        };
-        let refused = refused_clusters(mesh, &border, &contract, &image, dirty.as_deref());
-        if refused.is_empty() {
-            break;
-        }
-        let mut gone = vec![false; clusters];
-        for c in refused {
+    // The fans to check: all at first, then those that the last refusals changed, found
+    // through the triangles of each cluster.
+    let mut refused = refused_clusters(mesh, None, &border, &contract, &image_of(labels, &contract), None);
+    let by_cluster = (!refused.is_empty()).then(|| ClusterTriangles::new(mesh, labels, clusters));
+    let mut dirty = vec![false; clusters + mesh.positions.len()];
+    while let (false, Some(by_cluster)) = (refused.is_empty(), &by_cluster) {
+        for &c in &refused {
             contract[c as usize] = false;
-            gone[c as usize] = true;
         }
-        dirty = Some(changed_fans(mesh, labels, &gone, &contract));
+        let image = image_of(labels, &contract);
+        let changed: Vec<u32> = sorted_unique(
+            refused
+                .par_iter()
+                .flat_map_iter(|&c| by_cluster.of(c).iter().flat_map(|&t| mesh.triangles[t as usize].map(&image))),
+        );
+        // The triangles around every changed fan: its cluster's.
+        let around = sorted_unique(
+            sorted_unique(changed.par_iter().map(|&x| {
+                if (x as usize) < clusters {
+                    x
+                } else {
+                    labels[x as usize - clusters]
+                }
+            }))
+            .into_par_iter()
+            .flat_map_iter(|c| by_cluster.of(c).iter().copied()),
+        );
+        changed.iter().for_each(|&x| dirty[x as usize] = true);
+        refused = refused_clusters(mesh, Some(&around), &border, &contract, &image, Some(&dirty));
+        changed.iter().for_each(|&x| dirty[x as usize] = false);
     }
     // The mesh left: contracted clusters numbered by cluster, the other vertices after them.
-    let id = |v: u32| {
-        let c = labels[v as usize];
-        if contract[c as usize] {
-            c
-        } else {
-            clusters as u32 + v
-        }
-    };
-    let mut triangles: Vec<[u32; 3]> =
-        mesh.triangles.par_iter().map(|t| t.map(id)).filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2]).collect();
+    let id = image_of(labels, &contract);
+    let mut triangles: Vec<[u32; 3]> = mesh
+        .triangles
+        .par_iter()
+        .map(|t| t.map(&id))
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+        .collect();
     let kept = crate::reconstruct::renumber_used_vertices(&mut triangles, clusters + mesh.positions.len());
     let (positions, out_labels) = kept
         .iter()
@@ -199,22 +205,65 @@ fn disk_clusters(mesh: &Mesh, labels: &[u32], border: &[bool], clusters: usize) 
         .collect()
 }
 
-/// Per vertex of the mesh left (numbered as [`refused_clusters`] says, by `contract`), whether
-/// its fan changed when the clusters `gone` went back: the corners of every triangle with a
-/// vertex in one of them.
-fn changed_fans(mesh: &Mesh, labels: &[u32], gone: &[bool], contract: &[bool]) -> Vec<bool> {
-    let clusters = contract.len();
-    let changed: Vec<AtomicBool> = (0..clusters + mesh.positions.len()).map(|_| AtomicBool::new(false)).collect();
-    mesh.triangles.par_iter().for_each(|t| {
-        if t.iter().any(|&v| gone[labels[v as usize] as usize]) {
-            for &v in t {
-                let c = labels[v as usize];
-                let id = if contract[c as usize] { c as usize } else { clusters + v as usize };
-                changed[id].store(true, Ordering::Relaxed);
-            }
+/// The number of each vertex in the mesh left: its cluster's when `contract` says the cluster
+/// is contracted, else its own, after the clusters'.
+fn image_of<'a>(labels: &'a [u32], contract: &'a [bool]) -> impl Fn(u32) -> u32 + Sync + 'a {
+    move |v: u32| {
+        let c = labels[v as usize];
+        if contract[c as usize] {
+            c
+        } else {
+            contract.len() as u32 + v
         }
-    });
-    changed.into_par_iter().map(AtomicBool::into_inner).collect()
+    }
+}
+
+/// The numbers, sorted, once each.
+fn sorted_unique(numbers: impl ParallelIterator<Item = u32>) -> Vec<u32> {
+    let mut numbers: Vec<u32> = numbers.collect();
+    numbers.par_sort_unstable();
+    numbers.dedup();
+    numbers
+}
+
+/// The triangles of each cluster: those with a vertex in it (a triangle across clusters is in
+/// each of them).
+struct ClusterTriangles {
+    start: Vec<usize>,
+    triangles: Vec<u32>,
+}
+
+impl ClusterTriangles {
+    fn new(mesh: &Mesh, labels: &[u32], clusters: usize) -> ClusterTriangles {
+        let clusters_of = |t: &[u32; 3]| {
+            let [a, b, c] = t.map(|v| labels[v as usize]);
+            [Some(a), (b != a).then_some(b), (c != a && c != b).then_some(c)]
+        };
+        let counts: Vec<AtomicU32> = (0..clusters).map(|_| AtomicU32::new(0)).collect();
+        mesh.triangles.par_iter().for_each(|t| {
+            clusters_of(t).into_iter().flatten().for_each(|c| {
+                counts[c as usize].fetch_add(1, Ordering::Relaxed);
+            })
+        });
+        let mut start = Vec::with_capacity(clusters + 1);
+        start.push(0);
+        for count in counts {
+            start.push(start.last().unwrap() + count.into_inner() as usize);
+        }
+        // Filled in parallel, so a cluster's triangles come in any order.
+        let next: Vec<AtomicUsize> = start[..clusters].iter().map(|&s| AtomicUsize::new(s)).collect();
+        let triangles: Vec<AtomicU32> = (0..*start.last().unwrap()).map(|_| AtomicU32::new(0)).collect();
+        mesh.triangles.par_iter().enumerate().for_each(|(t, tri)| {
+            for c in clusters_of(tri).into_iter().flatten() {
+                triangles[next[c as usize].fetch_add(1, Ordering::Relaxed)].store(t as u32, Ordering::Relaxed);
+            }
+        });
+        ClusterTriangles { start, triangles: triangles.into_par_iter().map(AtomicU32::into_inner).collect() }
+    }
+
+    fn of(&self, cluster: u32) -> &[u32] {
+        &self.triangles[self.start[cluster as usize]..self.start[cluster as usize + 1]]
+    }
 }
 
 /// The clusters rule (2) refuses with the vertices numbered by `image` (a cluster that
@@ -223,9 +272,11 @@ fn changed_fans(mesh: &Mesh, labels: &[u32], gone: &[bool], contract: &[bool]) -
 /// that no triangle is left around: the whole piece of surface would vanish), and the
 /// contracted clusters around a vertex left alone whose fan is broken (not one simple cycle,
 /// or one simple path on the border), unless its own fan is. Only the fans `dirty` marks (by
-/// number) when it is given. Sorted, without repeats.
+/// number) when it is given, from the triangles `around` them (by index) when that is given.
+/// Sorted, without repeats.
 fn refused_clusters(
     mesh: &Mesh,
+    around: Option<&[u32]>,
     border: &[bool],
     contract: &[bool],
     image: &(impl Fn(u32) -> u32 + Sync),
@@ -234,15 +285,17 @@ fn refused_clusters(
     let clusters = contract.len();
     let check = |x: u32| dirty.is_none_or(|d| d[x as usize]);
     // Each corner of each triangle left: (the vertex, the far edge's two ends).
-    let mut corners: Vec<[u32; 3]> = mesh
-        .triangles
-        .par_iter()
-        .filter_map(|t| {
-            let i = t.map(image);
-            (i[0] != i[1] && i[1] != i[2] && i[0] != i[2] && i.iter().any(|&x| check(x))).then_some(i)
-        })
-        .flat_map_iter(|i| (0..3).map(move |k| [i[k], i[(k + 1) % 3], i[(k + 2) % 3]]).filter(|c| check(c[0])))
-        .collect();
+    let left = |t: &[u32; 3]| {
+        let i = t.map(image);
+        (i[0] != i[1] && i[1] != i[2] && i[0] != i[2] && i.iter().any(|&x| check(x))).then_some(i)
+    };
+    let corners_of = |i: [u32; 3]| (0..3).map(move |k| [i[k], i[(k + 1) % 3], i[(k + 2) % 3]]).filter(|c| check(c[0]));
+    let mut corners: Vec<[u32; 3]> = match around {
+        None => mesh.triangles.par_iter().filter_map(left).flat_map_iter(corners_of).collect(),
+        Some(around) => {
+            around.par_iter().filter_map(|&t| left(&mesh.triangles[t as usize])).flat_map_iter(corners_of).collect()
+        }
+    };
     corners.par_sort_unstable();
     let starts: Vec<usize> =
         (0..corners.len()).into_par_iter().filter(|&k| k == 0 || corners[k - 1][0] != corners[k][0]).collect();
