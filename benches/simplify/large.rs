@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 use vstree::{eval::shapes, io, Mesh};
 
 /// The sizes `--large` takes: name, corpus mesh, 1-to-4 splits. The meshes have handles (bull
-/// none, cheese 133, couplingdown 9), so keeping the genus is tested at every size.
-pub const SIZES: [(&str, &str, u32); 3] = [("3.5M", "bull", 4), ("14M", "cheese", 5), ("50M", "couplingdown", 7)];
+/// none, cheese 133, couplingdown 9, turbine 11), so keeping the genus is tested at every size.
+pub const SIZES: [(&str, &str, u32); 4] =
+    [("1M", "turbine", 3), ("3.5M", "bull", 4), ("14M", "cheese", 5), ("50M", "couplingdown", 7)];
 
 /// Noise on every vertex, in mean edge lengths.
 const NOISE_EDGES: f32 = 0.05;
@@ -18,7 +19,7 @@ const NOISE_EDGES: f32 = 0.05;
 /// and written under `dir` when absent.
 pub fn mesh(name: &str, data: &Path, dir: &Path) -> Result<(String, PathBuf, Mesh), String> {
     let &(_, model, splits) =
-        SIZES.iter().find(|s| s.0 == name).ok_or_else(|| format!("unknown size {name} (one of 3.5M, 14M, 50M)"))?;
+        SIZES.iter().find(|s| s.0 == name).ok_or_else(|| format!("unknown size {name} (one of 1M, 3.5M, 14M, 50M)"))?;
     let label = format!("{model} x{} ({name})", 1u32 << (2 * splits));
     let path = dir.join(format!("{model}-x{}.ply", 1u32 << (2 * splits)));
     if path.exists() {

@@ -13,7 +13,7 @@
 //! ```text
 //! cargo bench --bench simplify -- [--ratios 0.02,0.005] [--runs N] [--models a,b]
 //!     [--data ../shared/data] [--curve igea,camel] [--curve-ratios ...] [--peers a,b]
-//!     [--large 3.5M,14M,50M] [--stream 14M,50M,200M] [--meshlab-max 5000000] [--no-write]
+//!     [--large 1M,3.5M,14M,50M] [--stream 14M,50M,200M] [--meshlab-max 5000000] [--no-write]
 //! ```
 //!
 //! Besides the error against size of the `--curve` models, it draws the time against the
@@ -53,7 +53,7 @@ usage: cargo bench --bench simplify -- [options]
   --threads N         vstree's worker threads, 0 = all cores (default 0)
   --peers A,B         only these peers (default all: meshopt-simplify, meshopt-sloppy,
                       fast-simplification, meshlab-qec, meshlab-clustering; or none)
-  --large A,B         also generated meshes of these sizes (3.5M, 14M, 50M: corpus meshes split
+  --large A,B         also generated meshes of these sizes (1M, 3.5M, 14M, 50M: corpus meshes split
                       1-to-4 with a little noise, kept under target/bench-simplify/large/;
                       --models naming none of the data's skips those)
   --stream A,B        also stream generated bumpy tori of these sizes (14M, 50M, 200M triangles,
