@@ -7,9 +7,11 @@
 //! itself) off the mesh's border, and (2) after all contractions, the triangles around its
 //! vertex form one disk: their far edges make one simple cycle. (2) is checked on every vertex
 //! of the result, so two clusters that meet along two arcs (an edge with four triangles) or
-//! three that meet at two points (a repeated triangle) are refused too; a vertex left as it
-//! was whose fan is broken by its neighbours' contraction refuses those neighbours. Refusals
-//! change the neighbours' fans, so the check runs again until nothing more is refused.
+//! three that meet at two points (a repeated triangle) are refused too (the lowest-numbered of
+//! them); a vertex left as it was whose fan is broken by its neighbours' contraction refuses
+//! the neighbours to blame. Refusals change the neighbours' fans, so the check runs again on
+//! those fans until nothing more is refused. Before all this, a stray piece of a cluster joins
+//! a cluster it touches, so that noise along the tree's cuts does not leave clusters in pieces.
 
 use crate::mesh::Mesh;
 use crate::rng::mix64;
