@@ -1,5 +1,5 @@
 //! What the table benches (`benches/table1`, `benches/table2`, `benches/corpus`) share:
-//! command-line helpers, inputs drawn on a surface, distances relative to the diagonal, the
+//! command-line helpers, inputs drawn on a surface, distances relative to the diagonal, folds, the
 //! Markdown report's header and formatting, peak memory in a child process, the Python peers'
 //! plumbing, and what the reconstruction benches share (timed runs, the peers' records).
 //!
@@ -10,6 +10,7 @@
 
 pub mod cli;
 pub mod distance;
+pub mod folds;
 pub mod inputs;
 pub mod memory;
 pub mod peers;

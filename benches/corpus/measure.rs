@@ -11,8 +11,7 @@ use vstree::eval::distance::Target;
 use vstree::spatial::KdTree;
 use vstree::{topology, Mesh};
 
-/// Adjacent faces whose normals differ by more than this many degrees make a fold.
-pub const FOLD_DEGREES: f64 = 150.0;
+pub use crate::common::folds::{folds, FOLD_DEGREES};
 /// The sample spacing is the median nearest-neighbour distance over this many samples, evenly
 /// spread.
 const SPACING_SAMPLES: usize = 20_000;
@@ -105,11 +104,4 @@ pub fn quality(output: &Mesh, truth: &Truth, samples: Option<&Samples>) -> Quali
         boundary_edges: report.boundary_edges,
         farthest_face,
     }
-}
-
-/// Edges whose faces' normals differ by more than [`FOLD_DEGREES`] (every pair of faces on a
-/// non-manifold edge counts; degenerate faces have no normal and never fold).
-pub fn folds(mesh: &Mesh) -> usize {
-    let pairs = vstree::topology::adjacent_face_pairs(&mesh.triangles);
-    vstree::topology::folded_face_pairs(&mesh.positions, &mesh.triangles, &pairs, FOLD_DEGREES as f32).len()
 }

@@ -275,6 +275,7 @@ fn row(input: &Input, ratio: f64, method: &str, seconds: f64, one_thread: Option
         seconds_one_thread: one_thread,
         distances,
         non_manifold_edges: topology.non_manifold_edges,
+        folds: common::folds::folds(out),
         genus_kept,
     }
 }

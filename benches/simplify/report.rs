@@ -2,6 +2,7 @@
 //! numbers, a summary per method and size, and the full table per size.
 
 use crate::common::distance::Distances;
+use crate::common::folds::FOLD_DEGREES;
 use crate::common::report::{ms, percent, relative, thousands, verdict, Run};
 use crate::common::stats::{max, median, min};
 use crate::{NEW_MODE, REFERENCE};
@@ -25,6 +26,8 @@ pub struct Row {
     pub seconds_one_thread: Option<f64>,
     pub distances: Distances,
     pub non_manifold_edges: usize,
+    /// Edges whose faces turn back onto each other (see `common::folds`).
+    pub folds: usize,
     /// For closed manifold inputs: whether the output is closed and manifold with their genus.
     pub genus_kept: Option<bool>,
 }
@@ -185,15 +188,17 @@ impl Report {
 
     /// Every method against the reference, per size.
     fn summary(&self, md: &mut String) {
-        md.push_str(
+        let _ = write!(
+            md,
             "### Summary per method\n\n\
              Medians over the models of each method's ratio to meshoptimizer `simplify` on the same model \
              (Chamfer and Hausdorff: method / meshoptimizer; speed: meshoptimizer's time / method's); \
-             non-manifold: models whose output has a non-manifold edge; genus kept: closed inputs whose \
+             non-manifold: models whose output has a non-manifold edge; folds: edges whose faces turn by \
+             more than {FOLD_DEGREES:.0}°, summed over the models; genus kept: closed inputs whose \
              output is closed, manifold and of their genus.\n\n\
              | size | method | Chamfer ratio (median / worst) | Hausdorff ratio (median) | speed ratio (median / worst) \
-             | non-manifold | genus kept |\n\
-             |--:|---|--:|--:|--:|--:|--:|\n",
+             | non-manifold | folds | genus kept |\n\
+             |--:|---|--:|--:|--:|--:|--:|--:|\n",
         );
         for ratio in self.ratios() {
             for method in self.methods() {
@@ -219,7 +224,7 @@ impl Report {
                 };
                 let _ = writeln!(
                     md,
-                    "| {} | {} | {} / {} | {} | {} / {} | {} of {} | {} of {} |",
+                    "| {} | {} | {} / {} | {} | {} / {} | {} of {} | {} | {} of {} |",
                     percent(ratio),
                     method,
                     or_dash(&chamfers, &median, 2),
@@ -229,6 +234,7 @@ impl Report {
                     or_dash(&speeds, &min, 1),
                     nm,
                     rows.len(),
+                    thousands(rows.iter().map(|r| r.folds).sum()),
                     closed.iter().filter(|&&k| k).count(),
                     closed.len(),
                 );
@@ -241,8 +247,8 @@ impl Report {
         let _ = writeln!(
             md,
             "### At {} of the triangles\n\n\
-             | model | method | triangles | time (ms) | Chamfer | Hausdorff | non-manifold edges | genus kept |\n\
-             |---|---|--:|--:|--:|--:|--:|:-:|",
+             | model | method | triangles | time (ms) | Chamfer | Hausdorff | non-manifold edges | folds | genus kept |\n\
+             |---|---|--:|--:|--:|--:|--:|--:|:-:|",
             percent(ratio)
         );
         let mut last = String::new();
@@ -264,12 +270,13 @@ impl Report {
             };
             let _ = writeln!(
                 md,
-                "| {model} | {} | {} | {time} | {} | {} | {} | {genus} |",
+                "| {model} | {} | {} | {time} | {} | {} | {} | {} | {genus} |",
                 r.method,
                 thousands(r.triangles),
                 r.distances.chamfer().map_or("—".into(), relative),
                 r.distances.hausdorff().map_or("—".into(), relative),
                 thousands(r.non_manifold_edges),
+                thousands(r.folds),
             );
         }
         md.push('\n');
