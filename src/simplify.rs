@@ -410,10 +410,12 @@ fn simplify_to_size(
     let mut last_leaves = 0;
     let mut round = 1;
     let mut cluster_stats: Vec<CellStats>;
+    let mut cluster_leaves: Vec<u32>;
     let (out, out_clusters) = loop {
         let leaves = tree::fit(&mut tree, want, threads);
         let (clusters, stats) = cluster_with_stats(&tree, threads);
         cluster_stats = stats;
+        cluster_leaves = clusters.leaves.clone();
         let labels = vertex_labels(mesh, &samples, &clusters, params.sampling, &tree);
         // The tree has no leaf left to split: more rounds would give the same clusters.
         let exhausted = leaves < want || leaves <= last_leaves;
@@ -430,8 +432,8 @@ fn simplify_to_size(
     progress.report(0.9, "collapsing edges to the size")?;
     let mut out = out;
     out.origin = mesh.origin;
-    let out =
-        collapse_to_target(out, &out_clusters, &cluster_stats, &tree, target, threads, &mut progress.stage(0.9, 1.0))?;
+    let quadrics = threads.run(|| pieces::piece_quadrics(&out, &out_clusters, &cluster_stats, &tree, &cluster_leaves));
+    let out = collapse_to_target(out, quadrics, &tree, target, threads, &mut progress.stage(0.9, 1.0))?;
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
         tree: tree.stats(),
@@ -447,19 +449,17 @@ fn simplify_to_size(
     Ok((out, stats))
 }
 
-/// Brings the clustered mesh `out` (vertex v from cluster `out_clusters[v]`, whose sums are
-/// in `stats`, relative to `tree`'s root centre) to `target` triangles by quadric collapses;
-/// refused when nothing is left. The result is in `out`'s frame, at `out`'s origin.
+/// Brings the clustered mesh `out` (vertex v with quadric `quadrics[v]`, relative to `tree`'s
+/// root centre) to `target` triangles by quadric collapses; refused when nothing is left. The
+/// result is in `out`'s frame, at `out`'s origin.
 fn collapse_to_target(
     out: Mesh,
-    out_clusters: &[u32],
-    stats: &[CellStats],
+    quadrics: Vec<CellStats>,
     tree: &VsTree,
     target: usize,
     threads: &Threads,
     progress: &mut Progress,
 ) -> Result<Mesh> {
-    let quadrics = out_clusters.iter().map(|&c| stats[c as usize]).collect();
     let centre = tree.root().center.as_dvec3();
     let origin = out.origin;
     let mut out = if out.triangles.len() > target + 1 {
@@ -525,6 +525,7 @@ pub fn vertex_labels(
 mod chunks;
 mod contract;
 mod merge;
+mod pieces;
 mod stream;
 pub use stream::simplify_ply_streaming;
 #[cfg(test)]

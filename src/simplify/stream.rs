@@ -121,7 +121,8 @@ pub fn simplify_ply_streaming(
     progress.report(0.95, "collapsing edges to the size")?;
     let mut out = out;
     out.origin = origin;
-    let out = collapse_to_target(out, &out_clusters, &stats, &tree, target, &threads, &mut progress.stage(0.95, 1.0))?;
+    let quadrics = out_clusters.iter().map(|&c| stats[c as usize]).collect();
+    let out = collapse_to_target(out, quadrics, &tree, target, &threads, &mut progress.stage(0.95, 1.0))?;
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
         tree: tree.stats(),
