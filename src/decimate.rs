@@ -345,18 +345,12 @@ impl Decimator {
                     return true;
                 }
                 if before.dot(after) <= FOLD_COSINE * scale {
+                    let mut sample_normals = t.map(|v| self.quadrics[v as usize].sum_n);
+                    let folded = faces_against(before, sample_normals);
                     // The merged vertex has both ends' samples.
-                    let sample_normals = t.map(|v| {
-                        let q = &self.quadrics[v as usize];
-                        if v == x {
-                            q.sum_n + self.quadrics[other as usize].sum_n
-                        } else {
-                            q.sum_n
-                        }
-                    });
-                    let unfolds = faces_against(before, t.map(|v| self.quadrics[v as usize].sum_n))
-                        && !faces_against(after, sample_normals);
-                    if !unfolds {
+                    let k = t.iter().position(|&v| v == x).unwrap_or(0);
+                    sample_normals[k] += self.quadrics[other as usize].sum_n;
+                    if !folded || faces_against(after, sample_normals) {
                         return true;
                     }
                 }

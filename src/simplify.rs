@@ -409,14 +409,13 @@ fn simplify_to_size(
     let mut want = clusters_for(target, None, factor);
     let mut last_leaves = 0;
     let mut round = 1;
-    let mut cluster_stats: Vec<CellStats>;
-    let mut cluster_leaves: Vec<u32>;
+    // The last round's clusters and their samples' sums.
+    let mut last: (Clustering, Vec<CellStats>);
     let (out, out_clusters) = loop {
         let leaves = tree::fit(&mut tree, want, threads);
-        let (clusters, stats) = cluster_with_stats(&tree, threads);
-        cluster_stats = stats;
-        cluster_leaves = clusters.leaves.clone();
-        let labels = vertex_labels(mesh, &samples, &clusters, params.sampling, &tree);
+        last = cluster_with_stats(&tree, threads);
+        let clusters = &last.0;
+        let labels = vertex_labels(mesh, &samples, clusters, params.sampling, &tree);
         // The tree has no leaf left to split: more rounds would give the same clusters.
         let exhausted = leaves < want || leaves <= last_leaves;
         let last_round = exhausted || round == MAX_ROUNDS;
@@ -432,7 +431,8 @@ fn simplify_to_size(
     progress.report(0.9, "collapsing edges to the size")?;
     let mut out = out;
     out.origin = mesh.origin;
-    let quadrics = threads.run(|| pieces::piece_quadrics(&out, &out_clusters, &cluster_stats, &tree, &cluster_leaves));
+    let (clusters, cluster_stats) = last;
+    let quadrics = threads.run(|| pieces::piece_quadrics(&out, &out_clusters, &cluster_stats, &tree, &clusters.leaves));
     let out = collapse_to_target(out, quadrics, &tree, target, threads, &mut progress.stage(0.9, 1.0))?;
     progress.report(1.0, "done")?;
     let stats = SimplifyStats {
