@@ -24,7 +24,9 @@
  * copied out into caller buffers (`capacity` = number of elements the buffer holds).
  *
  * **Parameters.** Parameter structs start with `struct_size`: get one from its `_default()`
- * function and change fields by name, so programs keep working when fields are added.
+ * function and change fields by name, so programs keep working when fields are added. Every
+ * field's label, default, range, unit, description and choices are in the library's parameter
+ * table (vstree_param_count(), vstree_param_get(), vstree_param_find()): build dialogs from it.
  *
  * **Threads.** All functions may be called from any thread. Handles are immutable after
  * creation, so any number of threads may use the same handle at once (simplify the same mesh,
@@ -71,7 +73,7 @@
 /**
  * Minor version (semver).
  */
-#define VSTREE_VERSION_MINOR 9
+#define VSTREE_VERSION_MINOR 10
 
 /**
  * Patch version (semver).
@@ -166,6 +168,41 @@
  * `stopped` value: the next level would have exceeded `max_triangles`; raise it or the target.
  */
 #define VSTREE_REFINEMENT_STOPPED_TRIANGLE_BUDGET 3
+
+/**
+ * Which call a parameter belongs to: its struct is ::vstree_simplify_params.
+ */
+#define VSTREE_CALL_SIMPLIFY 0
+
+/**
+ * ::vstree_reconstruct_params.
+ */
+#define VSTREE_CALL_RECONSTRUCT 1
+
+/**
+ * ::vstree_normal_params.
+ */
+#define VSTREE_CALL_NORMALS 2
+
+/**
+ * A real number within the range.
+ */
+#define VSTREE_PARAM_REAL 0
+
+/**
+ * A whole number within the range.
+ */
+#define VSTREE_PARAM_INTEGER 1
+
+/**
+ * 0 (off) or 1 (on).
+ */
+#define VSTREE_PARAM_FLAG 2
+
+/**
+ * One of the parameter's choices (vstree_param_choice_get()), by its value.
+ */
+#define VSTREE_PARAM_CHOICE 3
 
 /**
  * The outcome of every fallible call. The numbers are part of the ABI: they never change and
@@ -1154,6 +1191,89 @@ typedef struct vstree_reconstruct_stats {
   double unsupported_share;
 } vstree_reconstruct_stats;
 
+/**
+ * One parameter of a call, as vstree_param_get() gives it. Static: never to be freed, valid
+ * as long as the library is loaded. Later versions only add fields at the end, and
+ * `struct_size` says how many there are.
+ */
+typedef struct vstree_param_info {
+  /**
+   * Size of this struct in bytes as the library filled it.
+   */
+  uint32_t struct_size;
+  /**
+   * The call: VSTREE_CALL_SIMPLIFY, VSTREE_CALL_RECONSTRUCT or VSTREE_CALL_NORMALS.
+   */
+  int32_t call;
+  /**
+   * VSTREE_PARAM_REAL, VSTREE_PARAM_INTEGER, VSTREE_PARAM_FLAG or VSTREE_PARAM_CHOICE.
+   */
+  int32_t kind;
+  /**
+   * Choices (VSTREE_PARAM_CHOICE), 0 otherwise.
+   */
+  uint32_t choice_count;
+  /**
+   * The field's name in the call's struct (and the Python keyword), e.g. "error".
+   */
+  const char *name;
+  /**
+   * The command line's flag without its dashes ("" where none sets this field alone).
+   */
+  const char *flag;
+  /**
+   * A short label for a dialog, e.g. "Error bound".
+   */
+  const char *label;
+  /**
+   * What the value counts in, e.g. "triangles" ("" for a choice or a plain number).
+   */
+  const char *unit;
+  /**
+   * What the parameter does: one paragraph of English for a tooltip.
+   */
+  const char *help;
+  /**
+   * The value the call's _default() function sets (a choice's value, a flag's 0 or 1).
+   */
+  double default_value;
+  /**
+   * The range: `min` to `max`, each end included unless `min_open`/`max_open` is 1;
+   * `max` is INFINITY where there is no upper end (a value must still be finite).
+   */
+  double min;
+  double max;
+  uint32_t min_open;
+  uint32_t max_open;
+} vstree_param_info;
+
+/**
+ * One value of a choice parameter (vstree_param_choice_get()). Static, as
+ * ::vstree_param_info.
+ */
+typedef struct vstree_param_choice {
+  /**
+   * Size of this struct in bytes as the library filled it.
+   */
+  uint32_t struct_size;
+  /**
+   * The number the struct's field holds for it.
+   */
+  int32_t value;
+  /**
+   * Its name as the command line and the bindings take it, e.g. "adaptive".
+   */
+  const char *name;
+  /**
+   * A short label for a dialog.
+   */
+  const char *label;
+  /**
+   * What it does.
+   */
+  const char *help;
+} vstree_param_choice;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -1640,6 +1760,56 @@ vstree_status vstree_reconstruct_result_take_mesh(struct vstree_reconstruct_resu
  * never to be freed. Thread-safe. Since 0.4.0.
  */
 const char *vstree_refinement_stopped_str(uint32_t stopped);
+
+/**
+ * How many parameters the table has (every call's together). Thread-safe.
+ */
+uint32_t vstree_param_count(void);
+
+/**
+ * Parameter `index` (0 to vstree_param_count() - 1), in each call's struct field order; NULL
+ * for an index out of range. Thread-safe.
+ */
+const struct vstree_param_info *vstree_param_get(uint32_t index);
+
+/**
+ * Choice `choice` (0 to `choice_count` - 1) of parameter `index`; NULL when either is out of
+ * range. Thread-safe.
+ */
+const struct vstree_param_choice *vstree_param_choice_get(uint32_t index, uint32_t choice);
+
+/**
+ * The index of `call`'s parameter `name` (a field name, e.g. "max_levels"), for
+ * vstree_param_get(); -1 when the call has no such parameter or `name` is NULL. Thread-safe.
+ *
+ * `name` must be NULL or a NUL-terminated string.
+ */
+int32_t vstree_param_find(int32_t call, const char *name);
+
+/**
+ * `target_faces` for a `ratio` of `triangles`: round(ratio x triangles), at least 1, at most
+ * `triangles`, as every host reads a "keep this fraction" setting. Fails with
+ * VSTREE_STATUS_INVALID_PARAMETER when `ratio` is not in (0, 1] or `triangles` is 0 (a point
+ * cloud), and when the count does not fit the field.
+ */
+vstree_status vstree_faces_for_ratio(double ratio, uint64_t triangles, uint32_t *out_faces);
+
+/**
+ * The L2 `error` that bounds every sample's tangent plane to within `distance` of its
+ * cluster's point, for a model whose bounding-box diagonal is `diagonal`: (distance /
+ * diagonal)^2 (the L2 bound sums squared plane distances over the squared diagonal). 0 when
+ * either is not a finite number above 0. Thread-safe.
+ */
+double vstree_l2_error_for_distance(double distance, double diagonal);
+
+/**
+ * Why a simplification to a size gave another size, as a static English sentence, or NULL when
+ * its output is within 1% (or 2 triangles) of `target_faces`, or no size was asked. `stats`
+ * from vstree_simplify_result_get_stats(); NULL gives NULL.
+ *
+ * `stats` must be NULL or point to a ::vstree_simplify_stats the library filled.
+ */
+const char *vstree_simplify_size_missed(const struct vstree_simplify_stats *stats);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -17,6 +17,8 @@ mod linalg;
 mod memory;
 pub mod mesh;
 pub mod normals;
+/// cbindgen:ignore
+pub mod params;
 mod polygonise;
 pub mod progress;
 mod quad_heap;

@@ -70,6 +70,74 @@ impl SimplifyParams {
     }
 }
 
+/// `target_faces` for a `ratio` of `triangles`: round(ratio x triangles), at least 1, as the
+/// command line and every host read "keep this fraction". A ratio outside (0, 1], or of a point
+/// cloud (no triangles), is an error naming `ratio`.
+pub fn faces_for_ratio(ratio: f64, triangles: u64) -> Result<usize> {
+    let bad = |message: String| Err(crate::Error::InvalidParameter { name: "ratio", message });
+    if !(ratio > 0.0 && ratio <= 1.0) {
+        return bad(format!("{ratio}: must be in (0, 1], a fraction of the input's triangles"));
+    }
+    if triangles == 0 {
+        return bad(format!(
+            "{ratio}: the input is a point cloud, with no triangles to take a fraction of: a ratio needs a mesh"
+        ));
+    }
+    Ok(((ratio * triangles as f64).round() as usize).clamp(1, usize::try_from(triangles).unwrap_or(usize::MAX)))
+}
+
+/// Why a simplification to a size gave another size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SizeMissed {
+    /// More triangles: fewer would change the topology that was kept.
+    Topology,
+    /// More triangles: no further edge collapses without folding or pinching the surface.
+    NoCollapse,
+    /// Fewer triangles: the input has no more distinct clusters to give.
+    NoClusters,
+}
+
+impl SizeMissed {
+    /// Outputs within this share of the target (or [`SizeMissed::SLACK_TRIANGLES`]) are on
+    /// target: the collapses stop within a triangle or two, the tree's cut within about 1%.
+    /// cbindgen:ignore
+    pub const SLACK_SHARE: usize = 100;
+    /// cbindgen:ignore
+    pub const SLACK_TRIANGLES: usize = 2;
+
+    /// Why `output` triangles came out where `target` were asked for (`kept_topology` as the
+    /// stats say), or `None` when it is on target or no size was asked.
+    pub fn of(target: usize, output: usize, kept_topology: bool) -> Option<SizeMissed> {
+        let slack = (target / Self::SLACK_SHARE).max(Self::SLACK_TRIANGLES);
+        if target == 0 || output.abs_diff(target) <= slack {
+            return None;
+        }
+        Some(if output < target {
+            SizeMissed::NoClusters
+        } else if kept_topology {
+            SizeMissed::Topology
+        } else {
+            SizeMissed::NoCollapse
+        })
+    }
+
+    /// The reason, as a sentence without a final stop.
+    pub fn reason(self) -> &'static str {
+        self.reason_c().to_str().expect("ASCII")
+    }
+
+    /// [`SizeMissed::reason`] for C.
+    pub fn reason_c(self) -> &'static std::ffi::CStr {
+        match self {
+            SizeMissed::Topology => {
+                c"fewer would change the topology (genus, borders); turning keep_topology off allows it"
+            }
+            SizeMissed::NoCollapse => c"no further edge can collapse without folding the surface or pinching it",
+            SizeMissed::NoClusters => c"the input has no more distinct clusters to give",
+        }
+    }
+}
+
 /// What [`simplify`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SimplifyStats {

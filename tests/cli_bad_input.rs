@@ -629,7 +629,7 @@ fn flag_cases() -> Vec<Case> {
             "simplify a cloud --ratio 0.5",
             vec![cloud_ply()],
             &["simplify", "cloud.ply", "out.ply", "--ratio", "0.5", "-q"],
-            error("--ratio: 0.5: the input is a point cloud, with no triangles to take a fraction of: a ratio needs a mesh (use --error)"),
+            error("--ratio: 0.5: the input is a point cloud, with no triangles to take a fraction of: a ratio needs a mesh"),
         ),
         // Each metric's own default bound; a size ignores the bound.
         succeeds(fail("simplify --metric density", vec![sphere_ply()], &simplify_with(&["--metric", "density", "-q"]), exact(""))),

@@ -26,15 +26,74 @@ using DistanceParam = RichAbsPerc;
 
 namespace {
 
-const QStringList kTreeKinds{"VS-Tree", "Octree"};
-const QStringList kMetrics{"L2 (quadric)", "L2,1 (normal deviation)", "Density (samples)"};
-const QStringList kSamplings{"Vertices", "Face centers"};
-const QStringList kKeepTopology{"Auto (edge-manifold inputs)", "On", "Off"};
 const QStringList kLabelKinds{"Cluster", "T-node"};
-// Indexed by the VSTREE_CLOSURE_* values.
-const QStringList kClosures{"Auto (open scans stay open)", "Closed", "Open"};
-static_assert(VSTREE_CLOSURE_AUTO == 0 && VSTREE_CLOSURE_CLOSED == 1 && VSTREE_CLOSURE_OPEN == 2,
-	"kClosures is indexed by the VSTREE_CLOSURE_* values");
+
+// The library's parameter table (vstree_param_get()) gives every parameter's label, default,
+// range, unit, description and choices: the dialogs are built from it, so they say what the
+// library does. The filters' parameter names stay MeshLab's (pymeshlab scripts use them).
+
+// The library's parameter `name` of `call` (VSTREE_CALL_*).
+const vstree_param_info& param(int32_t call, const char* name)
+{
+	const int32_t index = vstree_param_find(call, name);
+	const vstree_param_info* p = index < 0 ? nullptr : vstree_param_get(uint32_t(index));
+	if (p == nullptr)
+		throw MLException(QString("vstree: the library has no parameter '%1'").arg(name));
+	return *p;
+}
+
+// A parameter's description with its range and unit, for the dialog's tooltip.
+QString describe(const vstree_param_info& p)
+{
+	QString text = QString::fromUtf8(p.help);
+	if (p.kind == VSTREE_PARAM_REAL || p.kind == VSTREE_PARAM_INTEGER) {
+		const QString high = std::isinf(p.max) ? QString::fromUtf8("\u221e") : QString::number(p.max);
+		text += QString(" Range %1%2, %3%4").arg(p.min_open ? "(" : "[").arg(p.min).arg(high).arg(p.max_open || std::isinf(p.max) ? ")" : "]");
+		if (*p.unit != '\0')
+			text += QString(", in %1").arg(QString::fromUtf8(p.unit));
+		text += ".";
+	}
+	return text;
+}
+
+// The choices' labels, in the table's order (which is their values' order).
+QStringList choiceLabels(int32_t call, const char* name)
+{
+	const int32_t index = vstree_param_find(call, name);
+	const vstree_param_info& p = param(call, name);
+	QStringList labels;
+	for (uint32_t k = 0; k < p.choice_count; ++k)
+		labels << QString::fromUtf8(vstree_param_choice_get(uint32_t(index), k)->label);
+	return labels;
+}
+
+// The value of the choice a dialog's enum parameter `field` holds, for the library's `name`.
+int32_t choiceValue(const RichParameterList& par, const char* field, int32_t call, const char* name)
+{
+	const int32_t index = vstree_param_find(call, name);
+	const vstree_param_choice* c = vstree_param_choice_get(uint32_t(index), uint32_t(par.getEnum(field)));
+	if (c == nullptr)
+		throw MLException(QString("vstree: '%1' holds no choice of the library's '%2'").arg(field).arg(name));
+	return c->value;
+}
+
+RichEnum enumParam(const char* field, int32_t call, const char* name)
+{
+	const vstree_param_info& p = param(call, name);
+	return RichEnum(field, int(p.default_value), choiceLabels(call, name), QString::fromUtf8(p.label), describe(p));
+}
+
+RichFloat floatParam(const char* field, int32_t call, const char* name)
+{
+	const vstree_param_info& p = param(call, name);
+	return RichFloat(field, Scalarm(p.default_value), QString::fromUtf8(p.label), describe(p));
+}
+
+RichInt intParam(const char* field, int32_t call, const char* name)
+{
+	const vstree_param_info& p = param(call, name);
+	return RichInt(field, int(p.default_value), QString::fromUtf8(p.label), describe(p));
+}
 
 // A vstree status other than OK becomes an MLException carrying the C API's own message;
 // pymeshlab turns it into pymeshlab.PyMeshLabException.
@@ -161,10 +220,8 @@ void makeInput(const Arrays& a, bool withNormals, MeshHandle& h)
 // plane distances over diag^2 gives each one at most sqrt(e) * diag. Otherwise "error" as given.
 double l2Bound(const RichParameterList& par, double diagonal)
 {
-	const double d = double(par.getAbsPerc("distance"));
-	if (d <= 0 || diagonal <= 0)
-		return double(par.getFloat("error"));
-	return (d / diagonal) * (d / diagonal);
+	const double bound = vstree_l2_error_for_distance(double(par.getAbsPerc("distance")), diagonal);
+	return bound > 0 ? bound : double(par.getFloat("error"));
 }
 
 void addDistanceParam(RichParameterList& pl, double diagonal)
@@ -179,13 +236,9 @@ void addDistanceParam(RichParameterList& pl, double diagonal)
 vstree_simplify_params simplifyParams(const RichParameterList& par, double diagonal)
 {
 	vstree_simplify_params p = vstree_simplify_params_default();
-	p.tree_kind = par.getEnum("tree_kind") == 1 ? VSTREE_TREE_KIND_OCTREE : VSTREE_TREE_KIND_VS_TREE;
-	switch (par.getEnum("metric")) {
-	case 1: p.metric = VSTREE_METRIC_L21; break;
-	case 2: p.metric = VSTREE_METRIC_DENSITY; break;
-	default: p.metric = VSTREE_METRIC_L2; break;
-	}
-	p.sampling = par.getEnum("sampling") == 1 ? VSTREE_SAMPLING_FACE_CENTERS : VSTREE_SAMPLING_VERTICES;
+	p.tree_kind = choiceValue(par, "tree_kind", VSTREE_CALL_SIMPLIFY, "tree_kind");
+	p.metric = choiceValue(par, "metric", VSTREE_CALL_SIMPLIFY, "metric");
+	p.sampling = choiceValue(par, "sampling", VSTREE_CALL_SIMPLIFY, "sampling");
 	p.error    = double(par.getFloat("error"));
 	if (par.getAbsPerc("distance") > 0) {
 		if (p.metric != VSTREE_METRIC_L2)
@@ -199,25 +252,14 @@ vstree_simplify_params simplifyParams(const RichParameterList& par, double diago
 }
 
 // The size and topology parameters of the simplification filter (like MeshLab's quadric edge
-// collapse: a face count, or a fraction of the input's faces that overrides it), with the
-// library's defaults `d`.
-void addSizeParams(RichParameterList& pl, const vstree_simplify_params& d)
+// collapse: a face count, or a fraction of the input's faces that overrides it).
+void addSizeParams(RichParameterList& pl)
 {
-	pl.addParam(RichInt("target_faces", int(d.target_faces), "Target number of faces",
-		"The number of triangles wanted (within one): the tree is grown or cut, splitting the "
-		"cluster with the largest error first, and quadric edge collapses finish the count. The "
-		"error bound then only sets where the work starts. 0 uses the error bound. A closed "
-		"surface cannot go below what its genus needs (a tetrahedron's 4 at least): the result is "
-		"then the smallest mesh reachable, and the log says so."));
+	pl.addParam(intParam("target_faces", VSTREE_CALL_SIMPLIFY, "target_faces"));
 	pl.addParam(RichFloat("target_perc", 0, "Percentage reduction (0..1)",
 		"If non zero, the wanted size as a fraction of the input's faces (0.1 keeps 10%); it "
 		"overrides the target number of faces."));
-	pl.addParam(RichEnum("keep_topology", d.keep_topology, kKeepTopology, "Keep topology",
-		"Auto: for edge-manifold inputs (no edge in more than two faces: closed, or with borders as "
-		"scans have), clusters merge by edge collapses that keep the genus, the borders manifold "
-		"and the holes open; non-manifold inputs get plain clustering. On: keep the topology of "
-		"any input. Off: plain vertex clustering, faster, "
-		"which may fuse close sheets into non-manifold edges."));
+	pl.addParam(enumParam("keep_topology", VSTREE_CALL_SIMPLIFY, "keep_topology"));
 }
 
 // Sets the size and topology fields from the filter's parameters, for an input of `faces`
@@ -234,36 +276,21 @@ void setSize(const RichParameterList& par, size_t faces, vstree_simplify_params&
 								  "the error bound").arg(target));
 	p.target_faces = uint32_t(target);
 	if (perc > 0)
-		p.target_faces = uint32_t(std::max(1.0, std::round(perc * double(faces))));
-	switch (par.getEnum("keep_topology")) {
-	case 1: p.keep_topology = VSTREE_KEEP_TOPOLOGY_ON; break;
-	case 2: p.keep_topology = VSTREE_KEEP_TOPOLOGY_OFF; break;
-	default: p.keep_topology = VSTREE_KEEP_TOPOLOGY_AUTO; break;
-	}
+		check(vstree_faces_for_ratio(perc, faces, &p.target_faces), "faces_for_ratio");
+	p.keep_topology = choiceValue(par, "keep_topology", VSTREE_CALL_SIMPLIFY, "keep_topology");
 }
 
-// The tree's parameters, with the library's defaults (`d`, from vstree_simplify_params_default()).
-void addTreeParams(RichParameterList& pl, const vstree_simplify_params& d, double diagonal)
+// The tree's parameters, from the library's table.
+void addTreeParams(RichParameterList& pl, double diagonal)
 {
-	pl.addParam(RichFloat("error", Scalarm(d.error), "Error bound",
-		"Split threshold per cluster, read according to the metric. L2 (quadric): a relative "
-		"bound, the squared distance from a cluster's point to its samples' tangent planes over "
-		"the squared bounding-box diagonal (1e-3 = planes within about 3% of the diagonal; larger "
-		"= coarser). L2,1: unitless normal deviation, 1e-3 to 4. Density: a sample count >= 1."));
+	pl.addParam(floatParam("error", VSTREE_CALL_SIMPLIFY, "error"));
 	addDistanceParam(pl, diagonal);
-	pl.addParam(RichEnum("tree_kind", 0, kTreeKinds, "Tree",
-		"VS-Tree (octree far from the surface, quadtrees in local frames near it) or a plain Octree."));
-	pl.addParam(RichEnum("metric", 0, kMetrics, "Metric", "The error metric that decides whether a cell is split."));
-	pl.addParam(RichFloat("d_a", Scalarm(d.d_a), "d_a (normal cone)",
-		"Height-field test: a cell becomes a surface node only if every sample normal has a dot "
-		"product above d_a with the mean normal. Unitless, in [0, 1]."));
-	pl.addParam(RichFloat("d_d", Scalarm(d.d_d), "d_d (displacement)",
-		"Height-field test: sample heights above the cell's mean plane over its radius must stay "
-		"below d_d. Unitless, in [0, 1]."));
-	pl.addParam(RichEnum("sampling", 0, kSamplings, "Sampling",
-		"Which elements become the tree's samples: vertices (area-weighted normals) or face centers. "
-		"Point clouds always use their points."));
-	pl.addParam(RichInt("max_depth", int(d.max_depth), "Max depth", "Deepest tree level, in [1, 30]."));
+	pl.addParam(enumParam("tree_kind", VSTREE_CALL_SIMPLIFY, "tree_kind"));
+	pl.addParam(enumParam("metric", VSTREE_CALL_SIMPLIFY, "metric"));
+	pl.addParam(floatParam("d_a", VSTREE_CALL_SIMPLIFY, "d_a"));
+	pl.addParam(floatParam("d_d", VSTREE_CALL_SIMPLIFY, "d_d"));
+	pl.addParam(enumParam("sampling", VSTREE_CALL_SIMPLIFY, "sampling"));
+	pl.addParam(intParam("max_depth", VSTREE_CALL_SIMPLIFY, "max_depth"));
 }
 
 uint32_t hashColour(uint32_t x)
@@ -340,30 +367,20 @@ RichParameterList FilterVstreePlugin::parameters(ActionIDType f, const MeshModel
 	const double diagonal = double(m.cm.bbox.Diag());
 	switch (f) {
 	case FP_SIMPLIFY:
-		addSizeParams(pl, vstree_simplify_params_default());
-		addTreeParams(pl, vstree_simplify_params_default(), diagonal);
+		addSizeParams(pl);
+		addTreeParams(pl, diagonal);
 		break;
 	case FP_COLOUR:
-		addTreeParams(pl, vstree_simplify_params_default(), diagonal);
+		addTreeParams(pl, diagonal);
 		pl.addParam(RichEnum("label", 0, kLabelKinds, "Colour by",
 			"Cluster: one colour per cluster (leaf). T-node: one colour per T-node of the T-layer."));
 		break;
 	case FP_RECONSTRUCT: {
-		const vstree_reconstruct_params d = vstree_reconstruct_params_default();
-		pl.addParam(RichFloat("error", Scalarm(d.error), "Error bound",
-			"The tree's relative L2 bound: squared distance from a cluster's point to its samples' "
-			"tangent planes over the squared bounding-box diagonal. The de-noising control: larger = "
-			"smoother, fewer details."));
+		pl.addParam(floatParam("error", VSTREE_CALL_RECONSTRUCT, "error"));
 		addDistanceParam(pl, diagonal);
-		pl.addParam(RichInt("levels", int(d.max_levels), "Refinement levels",
-			"Most refinement levels, each multiplying the triangle count by 4; in [0, 12]."));
-		pl.addParam(RichEnum("surface", d.closure, kClosures, "Surface",
-			"Auto: open where the points cover one side only (a scan from one view: the output's "
-			"border follows the scan's), closed otherwise. Closed: holes and the back of a scan are "
-			"closed over. Open: only the part the points support, holes kept."));
-		pl.addParam(RichFloat("trim", Scalarm(d.trim), "Trim",
-			"Every face farther than this many grid cells from every point is removed. 0: only "
-			"past an open scan's border."));
+		pl.addParam(intParam("levels", VSTREE_CALL_RECONSTRUCT, "max_levels"));
+		pl.addParam(enumParam("surface", VSTREE_CALL_RECONSTRUCT, "closure"));
+		pl.addParam(floatParam("trim", VSTREE_CALL_RECONSTRUCT, "trim"));
 		pl.addParam(RichBool("estimate_normals", true, "Estimate normals",
 			"Estimate (and orient outward) the normals the point set lacks. When off, the point set "
 			"must have normals."));
@@ -407,16 +424,9 @@ std::map<std::string, QVariant> FilterVstreePlugin::apply(
 			(unsigned long long)s->t_nodes, (unsigned long long)s->s_nodes, s->max_depth,
 			s->seconds_total);
 		logf("topology %s", s->kept_topology ? "kept" : "not kept (plain clustering)");
-		if (s->target_faces > 0) {
-			const uint64_t slack = std::max<uint64_t>(2, s->target_faces / 100);
-			const uint64_t got = s->output_triangles, want = s->target_faces;
-			if ((got > want ? got - want : want - got) > slack)
-				logf("%llu triangles instead of the %llu asked for: %s", (unsigned long long)got,
-					(unsigned long long)want,
-					got > want ? (s->kept_topology ? "fewer would change the topology; set 'Keep topology' to Off to allow it"
-												   : "no further edge collapses without folding the surface")
-							   : "the input has no more distinct clusters to give");
-		}
+		if (const char* why = vstree_simplify_size_missed(s))
+			logf("%llu triangles instead of the %llu asked for: %s", (unsigned long long)s->output_triangles,
+				(unsigned long long)s->target_faces, why);
 		out["output_vertices"] = QVariant(int(s->output_vertices));
 		out["output_triangles"] = QVariant(int(s->output_triangles));
 		out["clusters"] = QVariant(int(s->clusters));
@@ -441,10 +451,11 @@ std::map<std::string, QVariant> FilterVstreePlugin::apply(
 		vstree_reconstruct_params p = vstree_reconstruct_params_default();
 		p.error = l2Bound(par, double(src->cm.bbox.Diag()));
 		const int levels = par.getInt("levels");
-		if (levels < 0)
-			throw MLException(QString("vstree: levels must be in [0, 12], got %1").arg(levels));
+		const vstree_param_info& range = param(VSTREE_CALL_RECONSTRUCT, "max_levels");
+		if (levels < range.min || levels > range.max)
+			throw MLException(QString("vstree: levels must be in [%1, %2], got %3").arg(range.min).arg(range.max).arg(levels));
 		p.max_levels = uint32_t(levels);
-		p.closure = int32_t(par.getEnum("surface"));
+		p.closure = choiceValue(par, "surface", VSTREE_CALL_RECONSTRUCT, "closure");
 		p.trim = float(par.getFloat("trim"));
 		vstree_reconstruct_result* res = nullptr;
 		check(vstree_reconstruct(in.p, &p, progressTrampoline, &prog, &res), "reconstruct");

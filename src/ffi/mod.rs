@@ -33,6 +33,8 @@ pub mod version;
 // Added in 0.1 after the three handles above: placed last so the header only grows at its end.
 pub mod normals;
 pub mod reconstruct;
+// Added in 0.10.
+pub mod param_table;
 
 use crate::error::Error;
 use params::CEnum;

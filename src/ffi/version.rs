@@ -6,7 +6,7 @@ use std::ffi::c_char;
 /// Major version (semver) of the library this header belongs to.
 pub const VSTREE_VERSION_MAJOR: u32 = 0;
 /// Minor version (semver).
-pub const VSTREE_VERSION_MINOR: u32 = 9;
+pub const VSTREE_VERSION_MINOR: u32 = 10;
 /// Patch version (semver).
 pub const VSTREE_VERSION_PATCH: u32 = 0;
 /// The ABI version: the number in the shared library's SONAME (`libvstree.so.0`). It changes

@@ -99,13 +99,7 @@ impl Default for NormalParams {
 impl NormalParams {
     /// Checks `neighbours` (the thread count is checked when the threads are started).
     pub fn check(&self) -> Result<()> {
-        if !(MIN_NEIGHBOURS..=MAX_NEIGHBOURS).contains(&self.neighbours) {
-            return Err(Error::param(
-                "neighbours",
-                format!("{}: must be from {MIN_NEIGHBOURS} to {MAX_NEIGHBOURS}", self.neighbours),
-            ));
-        }
-        Ok(())
+        crate::params::NORMALS_NEIGHBOURS.check(self.neighbours as f64, self.neighbours)
     }
 }
 

@@ -5,6 +5,7 @@
 use super::{refine::LevelStats, support::Closure};
 use crate::error::{Error, Result};
 use crate::normals::{NormalParams, NormalsReport};
+use crate::params;
 use crate::tree::{TreeKind, TreeParams, TreeStats};
 use std::ffi::CStr;
 
@@ -69,13 +70,13 @@ pub struct ReconstructParams {
 impl Default for ReconstructParams {
     fn default() -> Self {
         ReconstructParams {
-            tree: TreeParams { error: 1e-5, ..TreeParams::default() },
-            target_distance: 0.0,
-            max_levels: 6,
-            min_displaced: 0.02,
-            max_triangles: 20_000_000,
-            max_grid_depth: 10,
-            trim: 0.0,
+            tree: TreeParams { error: params::RECONSTRUCT_ERROR.default, ..TreeParams::default() },
+            target_distance: params::RECONSTRUCT_TARGET_DISTANCE.default,
+            max_levels: params::RECONSTRUCT_MAX_LEVELS.default_u32(),
+            min_displaced: params::RECONSTRUCT_MIN_DISPLACED.default,
+            max_triangles: params::RECONSTRUCT_MAX_TRIANGLES.default as usize,
+            max_grid_depth: params::RECONSTRUCT_MAX_GRID_DEPTH.default_u32(),
+            trim: params::RECONSTRUCT_TRIM.default as f32,
             closure: Closure::Auto,
             base_mesh: BaseMesh::default(),
             normals: NormalParams::default(),
@@ -124,31 +125,12 @@ impl ReconstructParams {
                 ),
             ));
         }
-        if !(self.target_distance.is_finite() && self.target_distance >= 0.0) {
-            return Err(Error::param(
-                "target_distance",
-                format!("{}: must be a finite number >= 0", self.target_distance),
-            ));
-        }
-        if self.max_levels > 12 {
-            return Err(Error::param("max_levels", format!("{}: must be from 0 to 12", self.max_levels)));
-        }
-        if !(0.0..=1.0).contains(&self.min_displaced) {
-            return Err(Error::param("min_displaced", format!("{}: must be in [0, 1]", self.min_displaced)));
-        }
-        if self.max_triangles == 0 || self.max_triangles > u32::MAX as usize {
-            return Err(Error::param(
-                "max_triangles",
-                format!("{}: must be from 1 to {}", self.max_triangles, u32::MAX),
-            ));
-        }
-        if !(4..=20).contains(&self.max_grid_depth) {
-            return Err(Error::param("max_grid_depth", format!("{}: must be from 4 to 20", self.max_grid_depth)));
-        }
-        if !(self.trim.is_finite() && self.trim >= 0.0) {
-            return Err(Error::param("trim", format!("{}: must be a finite number >= 0", self.trim)));
-        }
-        Ok(())
+        params::RECONSTRUCT_TARGET_DISTANCE.check(self.target_distance, self.target_distance)?;
+        params::RECONSTRUCT_MAX_LEVELS.check(self.max_levels.into(), self.max_levels)?;
+        params::RECONSTRUCT_MIN_DISPLACED.check(self.min_displaced, self.min_displaced)?;
+        params::RECONSTRUCT_MAX_TRIANGLES.check(self.max_triangles as f64, self.max_triangles)?;
+        params::RECONSTRUCT_MAX_GRID_DEPTH.check(self.max_grid_depth.into(), self.max_grid_depth)?;
+        params::RECONSTRUCT_TRIM.check(self.trim.into(), self.trim)
     }
 }
 

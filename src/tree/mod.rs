@@ -13,6 +13,7 @@ mod partition;
 mod validate;
 
 use crate::error::{shown, Error, Result};
+use crate::params;
 use crate::quadric::CellStats;
 use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
@@ -70,10 +71,10 @@ impl Default for TreeParams {
             kind: TreeKind::VsTree,
             metric: Metric::L2,
             error: TreeParams::DEFAULT_ERROR,
-            d_a: 0.0,
-            d_d: 1.0 / 6.0,
-            max_depth: 24,
-            min_cell_size: 1e-7,
+            d_a: params::SIMPLIFY_D_A.default as f32,
+            d_d: params::SIMPLIFY_D_D.default as f32,
+            max_depth: params::SIMPLIFY_MAX_DEPTH.default_u32(),
+            min_cell_size: params::SIMPLIFY_MIN_CELL_SIZE.default,
         }
     }
 }
@@ -85,7 +86,20 @@ impl TreeParams {
     /// The default L2 bound for simplification (reconstruction has its own, see
     /// [`crate::reconstruct::ReconstructParams`]).
     /// cbindgen:ignore
-    pub const DEFAULT_ERROR: f64 = 1e-3;
+    pub const DEFAULT_ERROR: f64 = params::SIMPLIFY_ERROR.default;
+
+    /// The L2 bound under which every sample's tangent plane passes within `distance` of its
+    /// cluster's point, for a model of bounding-box diagonal `diagonal`: the bound sums squared
+    /// plane distances over the squared diagonal, so (distance / diagonal)^2. 0 unless both are
+    /// finite and above 0.
+    pub fn l2_error_for_distance(distance: f64, diagonal: f64) -> f64 {
+        let usable = |x: f64| x.is_finite() && x > 0.0;
+        if usable(distance) && usable(diagonal) {
+            (distance / diagonal).powi(2)
+        } else {
+            0.0
+        }
+    }
 
     /// Rejects values outside their documented ranges, naming the parameter.
     pub fn check(&self) -> Result<()> {
@@ -103,19 +117,10 @@ impl TreeParams {
             }
             _ => {}
         }
-        if !(0.0..=1.0).contains(&self.d_a) {
-            return Err(Error::param("d_a", format!("{}: must be in [0, 1]", self.d_a)));
-        }
-        if !(0.0..=1.0).contains(&self.d_d) {
-            return Err(Error::param("d_d", format!("{}: must be in [0, 1]", self.d_d)));
-        }
-        if !(1..=MAX_DEPTH).contains(&self.max_depth) {
-            return Err(Error::param("max_depth", format!("{}: must be from 1 to {MAX_DEPTH}", self.max_depth)));
-        }
-        if !(self.min_cell_size.is_finite() && (0.0..1.0).contains(&self.min_cell_size)) {
-            return Err(Error::param("min_cell_size", format!("{}: must be in [0, 1)", self.min_cell_size)));
-        }
-        Ok(())
+        params::SIMPLIFY_D_A.check(self.d_a.into(), self.d_a)?;
+        params::SIMPLIFY_D_D.check(self.d_d.into(), self.d_d)?;
+        params::SIMPLIFY_MAX_DEPTH.check(self.max_depth.into(), self.max_depth)?;
+        params::SIMPLIFY_MIN_CELL_SIZE.check(self.min_cell_size, self.min_cell_size)
     }
 }
 

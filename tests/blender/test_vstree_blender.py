@@ -54,7 +54,7 @@ def test_registered(addon):
     assert hasattr(bpy.types, "VSTREE_PT_panel")
     ok, msg = addon.core.status()
     assert ok, msg
-    assert "libvstree 0.9.0" in msg
+    assert "libvstree 0.10.0" in msg
 
 
 def test_defaults_are_the_librarys(addon):
@@ -78,6 +78,36 @@ def test_defaults_are_the_librarys(addon):
     settings = sidebar.bl_rna.properties
     assert settings["recon_error"].default == pytest.approx(reconstruct.error, rel=1e-6)
     assert settings["max_levels"].default == reconstruct.max_levels and settings["trim"].default == reconstruct.trim
+
+
+def test_properties_are_the_library_table(addon):
+    """Every property made from the library's parameter table has the table's label, default,
+    range and choices, on the operators and the sidebar alike."""
+    table = {(p.call, p.name): p for p in addon.core.binding().parameters()}
+    rna = {
+        "VSTREE_OT_simplify": bpy.ops.vstree.simplify.get_rna_type(),
+        "VSTREE_OT_reconstruct": bpy.ops.vstree.reconstruct.get_rna_type(),
+        "VSTREE_OT_show_clusters": bpy.ops.vstree.show_clusters.get_rna_type(),
+        "VSTREE_PG_settings": bpy.context.scene.vstree.bl_rna,
+    }
+    checked = 0
+    for cls, rows in addon.TABLE_PROPERTIES.items():
+        for attribute, call, name in rows:
+            p, prop = table[(call, name)], rna[cls].properties[attribute]
+            assert prop.name == p.label, (cls, attribute)
+            if p.kind == "choice":
+                assert [item.identifier for item in prop.enum_items] == [c.name for c in p.choices], (cls, attribute)
+                assert prop.default == p.default, (cls, attribute)
+            else:
+                assert prop.default == pytest.approx(p.default, rel=1e-6), (cls, attribute)
+                if p.max < 1e30:
+                    assert prop.hard_max == pytest.approx(p.max), (cls, attribute)
+                if not p.min_open:
+                    assert prop.hard_min == pytest.approx(p.min), (cls, attribute)
+                else:
+                    assert prop.hard_min > p.min, (cls, attribute)
+            checked += 1
+    assert checked == 23
 
 
 def test_simplify_new_object(scene):

@@ -425,6 +425,48 @@ SPOILER(size_zero, struct_size, 0)
 SPOILER(size_short, struct_size, 4)
 SPOILER(size_long, struct_size, 4096)
 
+/* The library's parameter table: every row found by its name, its default the _default()
+ * functions' value, its default within its range, choices numbered 0..n-1; the host rules. */
+static void library_parameter_table(void) {
+  uint32_t i, k, count = vstree_param_count(), faces = 0;
+  vstree_simplify_params s = vstree_simplify_params_default();
+  vstree_reconstruct_params r = vstree_reconstruct_params_default();
+  vstree_normal_params n = vstree_normal_params_default();
+  CHECK(count >= 30);
+  for (i = 0; i < count; i++) {
+    const vstree_param_info *p = vstree_param_get(i);
+    CHECK(p != NULL && p->struct_size >= sizeof *p);
+    CHECK(p->name && p->flag && p->label && p->unit && p->help && p->label[0] && p->help[0]);
+    CHECK(vstree_param_find(p->call, p->name) == (int32_t)i);
+    CHECK(p->default_value >= p->min && p->default_value <= p->max);
+    CHECK((p->kind == VSTREE_PARAM_CHOICE) == (p->choice_count > 0));
+    for (k = 0; k < p->choice_count; k++) {
+      const vstree_param_choice *c = vstree_param_choice_get(i, k);
+      CHECK(c != NULL && c->value == (int32_t)k && c->name[0] && c->label[0]);
+    }
+    CHECK(vstree_param_choice_get(i, p->choice_count) == NULL);
+  }
+  CHECK(vstree_param_get(count) == NULL);
+  CHECK(vstree_param_find(VSTREE_CALL_NORMALS, "error") == -1);
+  CHECK(vstree_param_find(VSTREE_CALL_SIMPLIFY, NULL) == -1);
+#define DEFAULT(call, name) (vstree_param_get((uint32_t)vstree_param_find(call, name))->default_value)
+  CHECK(DEFAULT(VSTREE_CALL_SIMPLIFY, "error") == s.error);
+  CHECK(DEFAULT(VSTREE_CALL_SIMPLIFY, "max_depth") == s.max_depth);
+  CHECK(DEFAULT(VSTREE_CALL_SIMPLIFY, "keep_topology") == s.keep_topology);
+  CHECK(DEFAULT(VSTREE_CALL_RECONSTRUCT, "error") == r.error);
+  CHECK(DEFAULT(VSTREE_CALL_RECONSTRUCT, "max_levels") == r.max_levels);
+  CHECK(DEFAULT(VSTREE_CALL_RECONSTRUCT, "base_mesh") == r.base_mesh);
+  CHECK(DEFAULT(VSTREE_CALL_NORMALS, "neighbours") == n.neighbours);
+  CHECK(DEFAULT(VSTREE_CALL_NORMALS, "orient") == n.orient);
+#undef DEFAULT
+  CHECK(vstree_faces_for_ratio(0.25, 1000, &faces) == VSTREE_STATUS_OK && faces == 250);
+  CHECK(vstree_faces_for_ratio(1.5, 1000, &faces) == VSTREE_STATUS_INVALID_PARAMETER);
+  CHECK(strstr(vstree_last_error_message(), "`ratio`") != NULL);
+  CHECK(vstree_faces_for_ratio(0.5, 1000, NULL) == VSTREE_STATUS_NULL_POINTER);
+  CHECK(fabs(vstree_l2_error_for_distance(0.5, 10.0) - 0.0025) < 1e-15);
+  CHECK(vstree_simplify_size_missed(NULL) == NULL);
+}
+
 static void parameter_table(const vstree_mesh *mesh) {
   struct bad {
     const char *needle;
@@ -1051,6 +1093,7 @@ int main(int argc, char **argv) {
   far_mesh_creation(&t);
   mesh_files(mesh);
   mesh_copies(mesh, cloud_no_normals);
+  library_parameter_table();
   parameter_table(mesh);
   simplification(mesh, cloud, cloud_no_normals);
   trees(mesh);

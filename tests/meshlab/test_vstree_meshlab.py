@@ -331,6 +331,23 @@ def test_defaults_are_the_librarys():
     got = ms.filter_parameter_values(RECONSTRUCT)
     assert abs(got["error"] - reconstruct.error) <= 1e-6 * reconstruct.error, got["error"]
     assert got["levels"] == reconstruct.max_levels and got["trim"] == reconstruct.trim, got
+    # Every parameter the dialogs take from the library's table has the table's default (a
+    # choice: the index of its default among the table's choices, which the enum lists in order).
+    import vstree
+
+    table = {(p.call, p.name): p for p in vstree.parameters()}
+    simplify_rows = ["error", "tree_kind", "metric", "d_a", "d_d", "sampling", "max_depth", "target_faces", "keep_topology"]
+    fields = {
+        SIMPLIFY: [(f, "simplify", f) for f in simplify_rows],
+        RECONSTRUCT: [("error", "reconstruct", "error"), ("levels", "reconstruct", "max_levels"),
+                      ("surface", "reconstruct", "closure"), ("trim", "reconstruct", "trim")],
+    }
+    for name, rows in fields.items():
+        got = ms.filter_parameter_values(name)
+        for field, call, param in rows:
+            p = table[(call, param)]
+            want = [c.name for c in p.choices].index(p.default) if p.kind == "choice" else p.default
+            assert abs(got[field] - want) <= 1e-6 * abs(want), (name, field, got[field], want)
 
 
 if __name__ == "__main__":

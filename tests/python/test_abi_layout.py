@@ -26,6 +26,8 @@ STRUCTS = {
     "vstree_normals_report": _ffi.NormalsReport,
     "vstree_reconstruct_params": _ffi.ReconstructParams,
     "vstree_reconstruct_stats": _ffi.ReconstructStats,
+    "vstree_param_info": _ffi.ParamInfo,
+    "vstree_param_choice": _ffi.ParamChoice,
 }
 
 

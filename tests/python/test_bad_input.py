@@ -292,17 +292,17 @@ PARAMETER_CASES = [
     case("simplify-keep_topology-unknown-name", simplify_with(keep_topology="sometimes"), ValueError, None,
          "vstree.simplify: parameter `keep_topology`: 'sometimes' is not one of 'auto', 'off', 'on'"),
     case("simplify-ratio-zero", simplify_with(ratio=0), vstree.VstreeError, BAD,
-         "vstree.simplify: parameter `ratio`: 0: must be in (0, 1], a fraction of the triangles"),
+         "vstree.simplify: parameter `ratio`: 0: must be in (0, 1], a fraction of the input's triangles"),
     case("simplify-ratio-above-one", simplify_with(ratio=1.5), vstree.VstreeError, BAD,
-         "vstree.simplify: parameter `ratio`: 1.5: must be in (0, 1], a fraction of the triangles"),
+         "vstree.simplify: parameter `ratio`: 1.5: must be in (0, 1], a fraction of the input's triangles"),
     case("simplify-ratio-nan", simplify_with(ratio=NAN), vstree.VstreeError, BAD,
-         "vstree.simplify: parameter `ratio`: nan: must be in (0, 1], a fraction of the triangles"),
+         "vstree.simplify: parameter `ratio`: NaN: must be in (0, 1], a fraction of the input's triangles"),
     case("simplify-ratio-string", simplify_with(ratio="half"), TypeError, None,
          "vstree.simplify: parameter `ratio`: must be a real number, not 'half' (str)"),
     case("simplify-ratio-and-target", simplify_with(ratio=0.5, target_faces=10), TypeError, None,
          "vstree.simplify: give `ratio` or `target_faces`, not both"),
     case("simplify-ratio-on-a-cloud", lambda c: vstree.simplify(vstree.Mesh(CLOUD, None, CLOUD), ratio=0.5),
-         vstree.VstreeError, BAD, "vstree.simplify: parameter `ratio`: the input is a point cloud: a ratio needs triangles"),
+         vstree.VstreeError, BAD, "vstree.simplify: parameter `ratio`: 0.5: the input is a point cloud, with no triangles to take a fraction of: a ratio needs a mesh"),
     # simplify: what the binding refuses before C (names, types, C field widths).
     case("simplify-tree_kind-quadtree", simplify_with(tree_kind="quadtree"), ValueError, None,
          "vstree.simplify: parameter `tree_kind`: 'quadtree' is not one of 'octree', 'vstree'"),
@@ -329,8 +329,8 @@ PARAMETER_CASES = [
     case("simplify-error-none", simplify_with(error=None), TypeError, None,
          "vstree.simplify: parameter `error`: must be a real number, not None (NoneType)"),
     case("simplify-unknown-parameter", simplify_with(eror=1e-3), TypeError, None,
-         "vstree.simplify: unknown parameter 'eror' (the parameters are error, tree_kind, metric, "
-         "sampling, d_a, d_d, max_depth, threads, min_cell_size, keep_topology, target_faces)"),
+         "vstree.simplify: unknown parameter 'eror' (the parameters are tree_kind, metric, sampling, "
+         "error, d_a, d_d, max_depth, threads, min_cell_size, keep_topology, target_faces)"),
     # Tree: the same parameters, its own function name.
     case("tree-tree_kind-quadtree", tree_with(tree_kind="quadtree"), ValueError, None,
          "vstree.Tree: parameter `tree_kind`: 'quadtree' is not one of 'octree', 'vstree'"),
@@ -401,7 +401,7 @@ PARAMETER_CASES = [
     case("reconstruct-orient-none", reconstruct_with(orient=None), TypeError, None,
          "vstree.reconstruct: parameter `orient`: must be one of %s or an integer, not None (NoneType)" % ORIENT_NAMES),
     case("reconstruct-simplify-only-parameter", reconstruct_with(metric="l2"), TypeError, None,
-         "vstree.reconstruct: unknown parameter 'metric' (the parameters are error, orient, d_a, d_d, "
+         "vstree.reconstruct: unknown parameter 'metric' (the parameters are orient, error, d_a, d_d, "
          "max_depth, max_levels, min_cell_size, target_distance, min_displaced, max_triangles, "
          "max_grid_depth, trim, neighbours, reorient_given, threads, closure, base_mesh)"),
     case("reconstruct-closure-unknown", reconstruct_with(closure="half"), ValueError, None,

@@ -105,9 +105,42 @@ def test_simplify_to_a_size_keeps_a_closed_torus_closed(shape):
         assert s["kept_topology"] == 0 and abs(out.triangle_count - target) <= max(2, target // 100)
     out, s = vstree.simplify(mesh, ratio=0.05)
     assert s["target_faces"] == round(0.05 * len(t)) and euler_genus(out) == (1, True)
+    assert s["size_missed"] is None
     # Below what a torus allows: the smallest closed torus the collapses reach, never empty.
-    out, _ = vstree.simplify(mesh, target_faces=1)
+    out, s = vstree.simplify(mesh, target_faces=1)
     assert 14 <= out.triangle_count <= 60 and euler_genus(out) == (1, True)
+    assert "topology" in s["size_missed"]
+
+
+def test_parameters_are_the_library_table():
+    """Keywords, defaults and choices come from the library's table: the C structs' fields in
+    order, the _default() functions' values, and every choice name accepted by its keyword."""
+    import vstree._ffi as ffi
+
+    structs = {
+        "simplify": (ffi.SimplifyParams, vstree.lib.vstree_simplify_params_default()),
+        "reconstruct": (ffi.ReconstructParams, vstree.lib.vstree_reconstruct_params_default()),
+        "normals": (ffi.NormalParams, vstree.lib.vstree_normal_params_default()),
+    }
+    for call, (struct, defaults) in structs.items():
+        table = vstree.parameters(call)
+        assert [p.name for p in table] == [name for name, _ in struct._fields_ if name != "struct_size"]
+        for p in table:
+            value = getattr(defaults, p.name)
+            if p.kind == "choice":
+                assert [c.value for c in p.choices] == list(range(len(p.choices))), p.name
+                assert p.choices[value].name == p.default, p.name
+                for c in p.choices:
+                    assert vstree._ENUMS[p.name][c.name] == c.value
+            else:
+                assert value == pytest.approx(p.default, rel=1e-7), p.name
+            assert p.min <= (value if p.kind != "choice" else 0) <= p.max, p.name
+            assert p.label and p.help, p.name
+    assert {p.call for p in vstree.parameters()} == {"simplify", "reconstruct", "normals"}
+    levels = next(p for p in vstree.parameters("reconstruct") if p.name == "max_levels")
+    assert (levels.min, levels.max, levels.default, levels.flag) == (0, 12, 6, "levels")
+    with pytest.raises(ValueError, match="is not one of"):
+        vstree.parameters("decimate")
 
 
 def test_a_ply_file_is_simplified_streaming_without_being_loaded(shape, tmp_path):

@@ -422,22 +422,59 @@ def _as_indices(triangles):
 
 # ---- parameters -----------------------------------------------------------------------------
 
-_TREE_KINDS = {"vstree": 0, "octree": 1}
-_METRICS = {"l2": 0, "l21": 1, "density": 2}
-_SAMPLINGS = {"vertices": 0, "faces": 1, "face_centers": 1}
-_ORIENTATIONS = {"unoriented": 0, "propagate": 1, "propagate_majority": 2, "propagate_outward": 3}
-_CLOSURES = {"auto": 0, "closed": 1, "open": 2}
-_BASE_MESHES = {"winding": 0, "paper": 1, "adaptive": 2}
-_KEEP_TOPOLOGY = {"auto": 0, "on": 1, "off": 2}
-_ENUMS = {
-    "tree_kind": _TREE_KINDS,
-    "metric": _METRICS,
-    "sampling": _SAMPLINGS,
-    "orient": _ORIENTATIONS,
-    "closure": _CLOSURES,
-    "base_mesh": _BASE_MESHES,
-    "keep_topology": _KEEP_TOPOLOGY,
-}
+Choice = namedtuple("Choice", ["value", "name", "label", "help"])
+Choice.__doc__ = "One value of a choice parameter: its number, name (what the keyword takes), label and help."
+
+Param = namedtuple(
+    "Param", ["call", "name", "flag", "label", "kind", "default", "min", "max", "min_open", "max_open", "unit", "help", "choices"]
+)
+Param.__doc__ = """One parameter of a call, from the library's table (see :func:`parameters`):
+``call`` ("simplify", "reconstruct" or "normals"), ``name`` (the keyword), ``flag`` (the
+command line's, or ""), ``label``, ``kind`` ("real", "integer", "flag" or "choice"), ``default``
+(for a choice, its name), ``min``/``max`` (each end included unless ``min_open``/``max_open``;
+``max`` is ``inf`` where there is none), ``unit``, ``help`` and ``choices`` (a tuple of
+:class:`Choice`)."""
+
+_CALLS = ("simplify", "reconstruct", "normals")
+_KINDS = ("real", "integer", "flag", "choice")
+
+
+def _read_table():
+    table = []
+    for i in range(lib.vstree_param_count()):
+        p = lib.vstree_param_get(i).contents
+        choices = tuple(
+            Choice(c.value, c.name.decode(), c.label.decode(), c.help.decode())
+            for c in (lib.vstree_param_choice_get(i, k).contents for k in range(p.choice_count))
+        )
+        kind = _KINDS[p.kind]
+        default = p.default_value
+        if kind == "choice":
+            default = next(c.name for c in choices if c.value == default)
+        elif kind != "real":
+            default = int(default)
+        table.append(
+            Param(_CALLS[p.call], p.name.decode(), p.flag.decode(), p.label.decode(), kind, default, p.min, p.max,
+                  bool(p.min_open), bool(p.max_open), p.unit.decode(), p.help.decode(), choices)
+        )
+    return tuple(table)
+
+
+_TABLE = _read_table()
+
+
+def parameters(call=None):
+    """The library's parameters (a tuple of :class:`Param`), every call's or ``call``'s alone
+    ("simplify", "reconstruct" or "normals"): their keywords, defaults, ranges, units and
+    descriptions, as the command line, the MeshLab plugin and the Blender add-on show them."""
+    if call is not None and call not in _CALLS:
+        raise ValueError("vstree.parameters: call %r is not one of %s" % (call, ", ".join(map(repr, _CALLS))))
+    return tuple(p for p in _TABLE if call is None or p.call == call)
+
+
+# Choice names to numbers, per keyword; "face_centers" is sampling's older name.
+_ENUMS = {p.name: {c.name: c.value for c in p.choices} for p in _TABLE if p.kind == "choice"}
+_ENUMS["sampling"]["face_centers"] = _ENUMS["sampling"]["faces"]
 _C_INTEGERS = {ctypes.c_uint32: ("uint32", 0, 2**32 - 1), ctypes.c_int32: ("int32", -(2**31), 2**31 - 1)}
 
 
@@ -487,19 +524,7 @@ def _set_options(who, p, options, fields):
     return p
 
 
-_SIMPLIFY_FIELDS = (
-    "error",
-    "tree_kind",
-    "metric",
-    "sampling",
-    "d_a",
-    "d_d",
-    "max_depth",
-    "threads",
-    "min_cell_size",
-    "keep_topology",
-    "target_faces",
-)
+_SIMPLIFY_FIELDS = tuple(p.name for p in parameters("simplify"))
 
 
 def _params(who, options):
@@ -552,15 +577,12 @@ def _target_from_ratio(ratio, params, triangles):
         raise TypeError("%s: give `ratio` or `target_faces`, not both" % who)
     if isinstance(ratio, bool) or not isinstance(ratio, numbers.Real):
         raise TypeError("%s: parameter `ratio`: must be a real number, not %r (%s)" % (who, ratio, type(ratio).__name__))
-    if not 0.0 < float(ratio) <= 1.0:
-        raise VstreeError(
-            Status.INVALID_PARAMETER, "%s: parameter `ratio`: %r: must be in (0, 1], a fraction of the triangles" % (who, ratio)
-        )
-    if triangles == 0:
-        raise VstreeError(
-            Status.INVALID_PARAMETER, "%s: parameter `ratio`: the input is a point cloud: a ratio needs triangles" % who
-        )
-    return max(1, int(round(float(ratio) * triangles)))
+    faces = ctypes.c_uint32()
+    status = lib.vstree_faces_for_ratio(float(ratio), triangles, ctypes.byref(faces))
+    if status != Status.OK:
+        message = lib.vstree_last_error_message().decode("utf-8", "replace")
+        raise VstreeError(status, "%s: %s" % (who, message.split(": ", 1)[1]))
+    return faces.value
 
 
 SimplifyResult = namedtuple("SimplifyResult", ["mesh", "stats"])
@@ -579,7 +601,8 @@ def simplify(mesh, progress=None, ratio=None, **params):
 
     ``ratio`` (in (0, 1]) asks for that fraction of the input's triangles instead of
     ``target_faces`` (rounded, at least 1). Below what the topology allows, the result is the
-    smallest mesh reachable: ``stats["output_triangles"]`` says how many.
+    smallest mesh reachable: ``stats["output_triangles"]`` says how many, and
+    ``stats["size_missed"]`` why (None when the size was met within 1% or 2 triangles).
 
     ``progress(fraction, stage)`` is called on this thread; returning False cancels
     (:class:`CancelledError`). Returns ``SimplifyResult(mesh, stats)``.
@@ -611,10 +634,12 @@ def simplify_ply_file(path, progress=None, **params):
 def _simplify_result(result):
     """The mesh and statistics of a simplification's result handle, which is freed."""
     try:
-        stats = lib.vstree_simplify_result_get_stats(result).contents
-        if stats.struct_size < ctypes.sizeof(_ffi.SimplifyStats):
+        c_stats = lib.vstree_simplify_result_get_stats(result)
+        if c_stats.contents.struct_size < ctypes.sizeof(_ffi.SimplifyStats):
             raise VstreeError(Status.INTERNAL, "the library's statistics are older than this module")
-        stats = _struct_dict(stats)
+        stats = _struct_dict(c_stats.contents)
+        missed = lib.vstree_simplify_size_missed(ctypes.cast(c_stats, ctypes.c_void_p))
+        stats["size_missed"] = missed.decode() if missed is not None else None
     except BaseException:
         lib.vstree_simplify_result_free(result)
         raise
@@ -687,26 +712,8 @@ class Tree(_Owner):
 
 # ---- reconstruction and normal estimation ---------------------------------------------------
 
-_RECONSTRUCT_FIELDS = (
-    "error",
-    "orient",
-    "d_a",
-    "d_d",
-    "max_depth",
-    "max_levels",
-    "min_cell_size",
-    "target_distance",
-    "min_displaced",
-    "max_triangles",
-    "max_grid_depth",
-    "trim",
-    "neighbours",
-    "reorient_given",
-    "threads",
-    "closure",
-    "base_mesh",
-)
-_NORMAL_FIELDS = ("orient", "neighbours", "reorient_given", "threads")
+_RECONSTRUCT_FIELDS = tuple(p.name for p in parameters("reconstruct"))
+_NORMAL_FIELDS = tuple(p.name for p in parameters("normals"))
 
 
 def _cloud(points, normals):

@@ -258,6 +258,35 @@ class ReconstructStats(Structure):
     ]
 
 
+class ParamInfo(Structure):
+    _fields_ = [
+        ("struct_size", c_uint32),
+        ("call", c_int32),
+        ("kind", c_int32),
+        ("choice_count", c_uint32),
+        ("name", c_char_p),
+        ("flag", c_char_p),
+        ("label", c_char_p),
+        ("unit", c_char_p),
+        ("help", c_char_p),
+        ("default_value", c_double),
+        ("min", c_double),
+        ("max", c_double),
+        ("min_open", c_uint32),
+        ("max_open", c_uint32),
+    ]
+
+
+class ParamChoice(Structure):
+    _fields_ = [
+        ("struct_size", c_uint32),
+        ("value", c_int32),
+        ("name", c_char_p),
+        ("label", c_char_p),
+        ("help", c_char_p),
+    ]
+
+
 # ---- functions ------------------------------------------------------------------------------
 
 _F32P = POINTER(c_float)
@@ -265,6 +294,13 @@ _F64P = POINTER(c_double)
 _U32P = POINTER(c_uint32)
 _SIGNATURES = {
     "vstree_version": (c_char_p, []),
+    "vstree_param_count": (c_uint32, []),
+    "vstree_param_get": (POINTER(ParamInfo), [c_uint32]),
+    "vstree_param_choice_get": (POINTER(ParamChoice), [c_uint32, c_uint32]),
+    "vstree_param_find": (c_int32, [c_int32, c_char_p]),
+    "vstree_faces_for_ratio": (status_t, [c_double, c_uint64, _U32P]),
+    "vstree_l2_error_for_distance": (c_double, [c_double, c_double]),
+    "vstree_simplify_size_missed": (c_char_p, [c_void_p]),
     "vstree_abi_version": (c_uint32, []),
     "vstree_status_str": (c_char_p, [c_int32]),
     "vstree_last_error_message": (c_char_p, []),

@@ -56,62 +56,104 @@ def _is_mesh(context):
     return ob is not None and ob.type == 'MESH'
 
 
-TREE_KINDS = [
-    ('vstree', "VS-Tree", "Volume-Surface tree: octree down to the surface, then 2D quadtrees on it"),
-    ('octree', "Octree", "Plain octree clustering (for comparison)"),
-]
-METRICS = [
-    ('l2', "L2", "Sum of squared distances to the sample tangent planes"),
-    ('l21', "L2,1", "Normal deviation weighted by area"),
-    ('density', "Density", "Cluster size only"),
-]
-ORIENTS = [
-    ('propagate_outward', "Outward", "Propagate orientation, pointing outward"),
-    ('propagate', "Propagate", "Propagate orientation along a minimum spanning tree"),
-    ('propagate_majority', "Majority", "Propagate, then flip to the majority"),
-    ('unoriented', "Unoriented", "Do not orient the estimated normals"),
-]
 LABEL_KINDS = [
     ('cluster', "Clusters", "One colour per cluster (output vertex)"),
     ('t_node', "T-nodes", "One colour per T-node (2D tree root on the surface)"),
 ]
 
 
-CLOSURES = [
-    ('auto', "Auto", "Open where the points cover one side only (a scan from one view), closed otherwise"),
-    ('closed', "Closed", "Always closed: holes and the back of a scan are closed over"),
-    ('open', "Open", "Only the part of the surface the points support: holes stay open"),
-]
 
-KEEP_TOPOLOGY = [
-    ('auto', "Auto", "Keep it when no edge has more than two faces (closed, or with borders as scans have); plain clustering otherwise"),
-    ('on', "On", "Merge clusters only by collapses that keep the topology (borders stay manifold, holes open)"),
-    ('off', "Off", "Plain vertex clustering: faster, may fuse close sheets"),
-]
+# Properties made from the library's parameter table (vstree.parameters()): their label,
+# description, default, range and choices are the library's. The table is read when the
+# add-on registers; without the library the properties are placeholders, which no operator
+# reads (each first loads the library and reports why it cannot).
+#: Per class: (attribute, call, parameter).
+TABLE_PROPERTIES = {
+    "VSTREE_OT_simplify": [
+        ("error", "simplify", "error"),
+        ("tree_kind", "simplify", "tree_kind"),
+        ("metric", "simplify", "metric"),
+        ("threads", "simplify", "threads"),
+        ("keep_topology", "simplify", "keep_topology"),
+    ],
+    "VSTREE_OT_reconstruct": [
+        ("error", "reconstruct", "error"),
+        ("max_levels", "reconstruct", "max_levels"),
+        ("max_grid_depth", "reconstruct", "max_grid_depth"),
+        ("closure", "reconstruct", "closure"),
+        ("trim", "reconstruct", "trim"),
+        ("orient", "reconstruct", "orient"),
+        ("neighbours", "reconstruct", "neighbours"),
+        ("threads", "reconstruct", "threads"),
+    ],
+    "VSTREE_OT_show_clusters": [
+        ("error", "simplify", "error"),
+        ("tree_kind", "simplify", "tree_kind"),
+        ("metric", "simplify", "metric"),
+    ],
+    "VSTREE_PG_settings": [
+        ("error", "simplify", "error"),
+        ("tree_kind", "simplify", "tree_kind"),
+        ("metric", "simplify", "metric"),
+        ("recon_error", "reconstruct", "error"),
+        ("max_levels", "reconstruct", "max_levels"),
+        ("closure", "reconstruct", "closure"),
+        ("trim", "reconstruct", "trim"),
+    ],
+}
+
+#: Blender's properties hold 32-bit numbers: table ends beyond these are clamped to them.
+_FLOAT_LIMIT = 3.0e38
+_INT_LIMIT = 2**31 - 1
 
 
-# The library's defaults (vstree_simplify_params_default(), vstree_reconstruct_params_default()).
-# Properties are declared when the add-on registers, before the library is loaded (on first use,
-# so that enabling never fails), hence the copies; tests/blender checks that they agree.
-SIMPLIFY_ERROR = 1e-3
-RECONSTRUCT_ERROR = 1e-5
-RECONSTRUCT_LEVELS = 6
-GRID_DEPTH = 10
-TRIM = 0.0
-NEIGHBOURS = 16
+def _description(p):
+    if p.kind in ("real", "integer") and p.unit:
+        return "%s (%s)" % (p.help, p.unit)
+    return p.help
 
 
-def _error_prop(default):
+def table_property(p):
+    """The Blender property of a parameter of the library's table."""
+    if p.kind == "choice":
+        items = [(c.name, c.label, c.help) for c in p.choices]
+        return EnumProperty(name=p.label, items=items, default=p.default, description=p.help)
+    if p.kind == "flag":
+        return BoolProperty(name=p.label, default=bool(p.default), description=p.help)
+    if p.kind == "integer":
+        low, high = max(p.min, -_INT_LIMIT), min(p.max, _INT_LIMIT)
+        return IntProperty(name=p.label, default=p.default, min=int(low), max=int(high), description=_description(p))
+    # An open lower end of 0 (a bound must be above 0): the smallest step Blender shows.
+    low = 1e-9 if p.min_open and p.min == 0 else max(p.min, -_FLOAT_LIMIT)
+    high = min(p.max, _FLOAT_LIMIT)
+    small = p.default != 0 and abs(p.default) < 1e-2
     return FloatProperty(
-        name="Error",
-        description="L2 bound of a cluster, relative to the squared bounding-box diagonal "
-        "(larger = coarser)",
-        default=default,
-        min=1e-9,
-        max=1.0,
-        precision=6,
-        step=1,
+        name=p.label, default=p.default, min=low, max=high, description=_description(p),
+        # Bounds like 1e-5 need digits; the slider moves by a hundredth of a unit.
+        precision=7 if small else 3, step=1,
+        soft_max=min(high, 1.0) if small else high,
     )
+
+
+def _placeholder(attribute):
+    return StringProperty(name=attribute, description="The vstree library is not loaded")
+
+
+def _add_table_properties():
+    """Gives each class of TABLE_PROPERTIES its properties from the library's table."""
+    try:
+        table = {(p.call, p.name): p for p in core.binding().parameters()}
+    except core.VstreeUnavailable:
+        table = {}
+    for cls in classes:
+        # The class's own annotations, never a base class's.
+        own = cls.__dict__.get("__annotations__")
+        if own is None:
+            own = {}
+            cls.__annotations__ = own
+        for attribute, call, name in TABLE_PROPERTIES.get(cls.__name__, []):
+            p = table.get((call, name))
+            own[attribute] = table_property(p) if p is not None else _placeholder(attribute)
 
 
 class _Worker:
@@ -224,9 +266,6 @@ class VSTREE_OT_simplify(_Worker, bpy.types.Operator):
     bl_label = "VS-Tree Simplify"
     bl_options = {'REGISTER', 'UNDO'}
 
-    error: _error_prop(SIMPLIFY_ERROR)
-    tree_kind: EnumProperty(name="Tree", items=TREE_KINDS, default='vstree', description="Clustering tree")
-    metric: EnumProperty(name="Metric", items=METRICS, default='l2', description="Cluster error metric")
     apply_modifiers: BoolProperty(
         name="Apply Modifiers",
         default=True,
@@ -238,7 +277,6 @@ class VSTREE_OT_simplify(_Worker, bpy.types.Operator):
         default=False,
         description="Replace the object's mesh (undoable) instead of adding a new object",
     )
-    threads: IntProperty(name="Threads", default=0, min=0, max=1024, description="Worker threads (0 = all cores)")
     ratio: FloatProperty(
         name="Ratio",
         default=0.0,
@@ -247,12 +285,6 @@ class VSTREE_OT_simplify(_Worker, bpy.types.Operator):
         subtype='FACTOR',
         description="Fraction of the triangles to keep, like the Decimate modifier's ratio (the count "
         "is met within one triangle); 0 = use the error bound",
-    )
-    keep_topology: EnumProperty(
-        name="Keep Topology",
-        items=KEEP_TOPOLOGY,
-        default='auto',
-        description="Keep a closed mesh closed and manifold with its genus",
     )
 
     @classmethod
@@ -299,22 +331,6 @@ class VSTREE_OT_reconstruct(_Worker, bpy.types.Operator):
     bl_label = "VS-Tree Reconstruct"
     bl_options = {'REGISTER', 'UNDO'}
 
-    error: _error_prop(RECONSTRUCT_ERROR)
-    max_levels: IntProperty(
-        name="Levels", default=RECONSTRUCT_LEVELS, min=0, max=12, description="Refinement levels after the base mesh"
-    )
-    max_grid_depth: IntProperty(
-        name="Grid Depth", default=GRID_DEPTH, min=4, max=20, description="Depth of the refinement grid"
-    )
-    closure: EnumProperty(name="Surface", items=CLOSURES, default='auto', description="Open or closed output")
-    trim: FloatProperty(
-        name="Trim", default=TRIM, min=0.0, max=100.0,
-        description="Remove every triangle farther than this many grid cells from the points (0: only past an open scan's border)",
-    )
-    orient: EnumProperty(name="Orient", items=ORIENTS, default='propagate_outward', description="Orientation of estimated normals")
-    neighbours: IntProperty(name="Neighbours", default=NEIGHBOURS, min=3, max=256, description="Neighbours for normal estimation")
-    threads: IntProperty(name="Threads", default=0, min=0, max=1024, description="Worker threads (0 = all cores)")
-
     @classmethod
     def poll(cls, context):
         return _is_mesh(context)
@@ -359,9 +375,6 @@ class VSTREE_OT_show_clusters(_Worker, bpy.types.Operator):
     bl_label = "VS-Tree Show Clusters"
     bl_options = {'REGISTER', 'UNDO'}
 
-    error: _error_prop(SIMPLIFY_ERROR)
-    tree_kind: EnumProperty(name="Tree", items=TREE_KINDS, default='vstree', description="Clustering tree")
-    metric: EnumProperty(name="Metric", items=METRICS, default='l2', description="Cluster error metric")
     kind: EnumProperty(name="Colour By", items=LABEL_KINDS, default='cluster', description="What gets one colour")
     attribute: StringProperty(name="Attribute", default="vstree_cluster", description="Name of the colour attribute")
 
@@ -390,21 +403,8 @@ class VSTREE_OT_show_clusters(_Worker, bpy.types.Operator):
 class VSTREE_PG_settings(bpy.types.PropertyGroup):
     """Sidebar parameters, passed to the operators by the panel's buttons."""
 
-    error: _error_prop(SIMPLIFY_ERROR)
-    tree_kind: EnumProperty(name="Tree", items=TREE_KINDS, default='vstree', description="Clustering tree")
-    metric: EnumProperty(name="Metric", items=METRICS, default='l2', description="Cluster error metric")
     apply_modifiers: BoolProperty(name="Apply Modifiers", default=True, description="Use the evaluated mesh")
     in_place: BoolProperty(name="In Place", default=False, description="Replace the object's mesh")
-    recon_error: FloatProperty(
-        name="Error", default=RECONSTRUCT_ERROR, min=1e-9, max=1.0, precision=7, step=1,
-        description="De-noising control of reconstruction (the tree's L2 bound)",
-    )
-    max_levels: IntProperty(name="Levels", default=RECONSTRUCT_LEVELS, min=0, max=12, description="Refinement levels")
-    closure: EnumProperty(name="Surface", items=CLOSURES, default='auto', description="Open or closed output")
-    trim: FloatProperty(
-        name="Trim", default=TRIM, min=0.0, max=100.0,
-        description="Trim distance in grid cells (0: only past an open scan's border)",
-    )
     kind: EnumProperty(name="Colour By", items=LABEL_KINDS, default='cluster', description="What gets one colour")
 
 
@@ -420,7 +420,11 @@ class VSTREE_PT_panel(bpy.types.Panel):
         layout = self.layout
         ok, msg = core.status()
         if not ok:
+            # Without the library the parameters are placeholders: only the message is shown.
             layout.label(text="Native library missing", icon='ERROR')
+            for line in textwrap.wrap(msg, 60):
+                layout.label(text=line)
+            return
         col = layout.column(align=True)
         col.label(text="Simplify / Clusters")
         col.prop(s, "error")
@@ -444,8 +448,7 @@ class VSTREE_PT_panel(bpy.types.Panel):
         op.error, op.max_levels, op.closure, op.trim = s.recon_error, s.max_levels, s.closure, s.trim
         # The sidebar does not wrap labels: a failure's message (which names the zip to
         # install) is shown whole, a line per label.
-        for line in [msg] if ok else textwrap.wrap(msg, 60):
-            layout.label(text=line)
+        layout.label(text=msg)
 
 
 class VSTREE_MT_menu(bpy.types.Menu):
@@ -474,6 +477,7 @@ classes = (
 
 
 def register():
+    _add_table_properties()
     for c in classes:
         bpy.utils.register_class(c)
     bpy.types.Scene.vstree = PointerProperty(type=VSTREE_PG_settings)

@@ -1,10 +1,41 @@
 //! The command line's flags and subcommands, and their conversion into library parameters.
 
+use clap::builder::PossibleValue;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
-use vstree::reconstruct::ReconstructParams;
+use vstree::params::{self, Param};
 use vstree::tree::{Metric, TreeKind, TreeParams};
 use vstree::{MeshSampling, Threads};
+
+/// A flag's help from the parameter table: what it does, its range and unit.
+fn help(p: &Param) -> String {
+    let unit = if p.unit.is_empty() { String::new() } else { format!(", in {}", p.unit) };
+    match p.kind {
+        params::Kind::Choice | params::Kind::Flag => p.help.to_string(),
+        _ => format!("{} ({}{unit}).", p.help.trim_end_matches('.'), p.range_text()),
+    }
+}
+
+/// The table's default of an integer parameter, as the flag reads it.
+fn integer(p: &Param) -> i64 {
+    p.default as i64
+}
+
+/// Implements [`ValueEnum`] for a flag's enum from the parameter table's choices of `param`:
+/// the variants in the choices' order, named and described as the table says.
+macro_rules! table_choices {
+    ($enum:ident, $param:expr, [$($variant:ident),+ $(,)?]) => {
+        impl ValueEnum for $enum {
+            fn value_variants<'a>() -> &'a [Self] {
+                &[$($enum::$variant),+]
+            }
+            fn to_possible_value(&self) -> Option<PossibleValue> {
+                let choice = $param.choices[*self as usize];
+                Some(PossibleValue::new(choice.name).help(choice.help))
+            }
+        }
+    };
+}
 
 #[derive(Parser)]
 #[command(
@@ -41,8 +72,7 @@ pub(crate) enum Command {
         output: PathBuf,
         #[command(flatten)]
         tree: TreeArgs,
-        /// Which mesh elements become samples.
-        #[arg(long, value_enum, default_value_t = Sampling::Vertices)]
+        #[arg(long, value_enum, default_value_t = Sampling::Vertices, help = help(&params::SIMPLIFY_SAMPLING))]
         sampling: Sampling,
         /// Triangles wanted (instead of --error): the tree is grown or cut, splitting the
         /// cluster with the largest error first, and quadric edge collapses bring the mesh to
@@ -91,18 +121,14 @@ pub(crate) enum Command {
         output: PathBuf,
         #[command(flatten)]
         tree: TreeArgs,
-        /// Stop refining once the RMS distance from the samples to the mesh is at most this
-        /// fraction of the bounding-box diagonal, splitting only the regions whose samples are
-        /// farther than this (0 = refine everywhere while the tree has detail left).
-        #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().target_distance)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = params::RECONSTRUCT_TARGET_DISTANCE.default,
+              help = help(&params::RECONSTRUCT_TARGET_DISTANCE))]
         target: f64,
-        /// Most refinement levels (each one multiplies the triangles by 4).
-        #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().max_levels.into())]
+        #[arg(long, allow_hyphen_values = true, default_value_t = integer(&params::RECONSTRUCT_MAX_LEVELS),
+              help = help(&params::RECONSTRUCT_MAX_LEVELS))]
         levels: i64,
-        /// Remove every face farther than this many grid cells from every sample, and make the
-        /// output open (0 = no such trimming: open scans are found and cut at their border
-        /// without it).
-        #[arg(long, allow_hyphen_values = true, default_value_t = ReconstructParams::default().trim)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = params::RECONSTRUCT_TRIM.default as f32,
+              help = help(&params::RECONSTRUCT_TRIM))]
         trim: f32,
         /// Keep only the part of the surface that the samples support, whatever its share: a
         /// scan's holes stay open too. By default the output is open only where much of the
@@ -116,15 +142,12 @@ pub(crate) enum Command {
         /// is now.
         #[arg(long, hide = true)]
         detect_open: bool,
-        /// What decides the base mesh's inside and outside.
-        #[arg(long, value_enum, default_value_t = BaseMeshArg::Adaptive)]
+        #[arg(long, value_enum, default_value_t = BaseMeshArg::Adaptive, help = help(&params::RECONSTRUCT_BASE_MESH))]
         base_mesh: BaseMeshArg,
-        /// Re-orient the normals the cloud already has (consistent by spanning-tree
-        /// propagation, then facing outward). Clouds without normals always get them estimated.
-        #[arg(long)]
+        #[arg(long, help = help(&params::RECONSTRUCT_REORIENT_GIVEN))]
         reorient: bool,
-        /// Neighbours used to estimate normals (3-256).
-        #[arg(long, allow_hyphen_values = true, default_value_t = vstree::normals::DEFAULT_NEIGHBOURS as i64)]
+        #[arg(long, allow_hyphen_values = true, default_value_t = integer(&params::RECONSTRUCT_NEIGHBOURS),
+              help = help(&params::RECONSTRUCT_NEIGHBOURS))]
         neighbours: i64,
         /// Write PLY as text instead of binary.
         #[arg(long)]
@@ -144,8 +167,7 @@ pub(crate) enum Command {
         input: PathBuf,
         #[command(flatten)]
         tree: TreeArgs,
-        /// Which mesh elements become samples.
-        #[arg(long, value_enum, default_value_t = Sampling::Vertices)]
+        #[arg(long, value_enum, default_value_t = Sampling::Vertices, help = help(&params::SIMPLIFY_SAMPLING))]
         sampling: Sampling,
         /// Also build the other kind of tree (octree or VS-Tree) and compare cluster counts.
         #[arg(long)]
@@ -159,39 +181,26 @@ pub(crate) const SIMPLIFY_ERROR: f64 = TreeParams::DEFAULT_ERROR;
 
 #[derive(Args, Clone)]
 pub(crate) struct TreeArgs {
-    /// Hierarchy: the VS-Tree, or a plain octree (the baseline).
-    #[arg(long, value_enum, default_value_t = Kind::Vstree)]
+    #[arg(long, value_enum, default_value_t = Kind::Vstree, help = help(&params::SIMPLIFY_TREE_KIND))]
     pub(crate) tree: Kind,
-    /// Error metric that decides when a cell is split.
-    #[arg(long, value_enum, default_value_t = MetricArg::L2)]
+    #[arg(long, value_enum, default_value_t = MetricArg::L2, help = help(&params::SIMPLIFY_METRIC))]
     pub(crate) metric: MetricArg,
-    /// Error bound per cluster. L2: sum of squared sample-plane distances over the squared
-    /// bounding-box diagonal (every sample's tangent plane then passes within sqrt(error) x
-    /// diagonal of its cluster's point); l21: mean squared normal deviation (0-4); density:
-    /// samples per cluster.
-    /// Larger = coarser output (and, to reconstruct, smoother: it is the de-noising control).
-    /// Given a size (--faces, --ratio), the bound is no bound and is not used.
-    /// [default: 1e-3 to simplify and for stats, 1e-5 to reconstruct; l21: 1e-3; density: 16]
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(long, allow_hyphen_values = true, help = error_help())]
     pub(crate) error: Option<f64>,
-    /// Normal-cone threshold of the height-field test, in [0, 1]: a cell becomes a surface
-    /// (2D) node only if every normal's dot product with the mean normal exceeds it. Raise it
-    /// for more adaptivity in curved areas.
-    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().d_a)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = params::SIMPLIFY_D_A.default as f32,
+          help = help(&params::SIMPLIFY_D_A))]
     pub(crate) da: f32,
-    /// Displacement threshold of the height-field test, in [0, 1]: a cell's height range over
-    /// its radius must stay below it. Lower it for more adaptivity in curved areas.
-    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().d_d)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = params::SIMPLIFY_D_D.default as f32,
+          help = help(&params::SIMPLIFY_D_D))]
     pub(crate) dd: f32,
-    /// Deepest tree level (1-30).
-    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().max_depth.into())]
+    #[arg(long, allow_hyphen_values = true, default_value_t = integer(&params::SIMPLIFY_MAX_DEPTH),
+          help = help(&params::SIMPLIFY_MAX_DEPTH))]
     pub(crate) max_depth: i64,
-    /// Cells smaller than this fraction of the bounding-box diagonal are not split, in [0, 1):
-    /// guards against duplicate points.
-    #[arg(long, allow_hyphen_values = true, default_value_t = TreeParams::default().min_cell_size)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = params::SIMPLIFY_MIN_CELL_SIZE.default,
+          help = help(&params::SIMPLIFY_MIN_CELL_SIZE))]
     pub(crate) min_cell_size: f64,
-    /// Worker threads (0 = all cores).
-    #[arg(long, allow_hyphen_values = true, default_value_t = 0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = integer(&params::SIMPLIFY_THREADS),
+          help = help(&params::SIMPLIFY_THREADS))]
     pub(crate) threads: i64,
     /// No progress bar and no report: print nothing but errors (`stats` still prints its
     /// statistics, which are its output).
@@ -199,44 +208,52 @@ pub(crate) struct TreeArgs {
     pub(crate) quiet: bool,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
+/// `--error`'s help: the L2 bound's row, with reconstruction's default beside simplification's.
+fn error_help() -> String {
+    format!(
+        "{} To reconstruct: {} [default: {:e} to simplify and for stats, {:e} to reconstruct; l21: {:e}; density: {}]",
+        params::SIMPLIFY_ERROR.help,
+        params::RECONSTRUCT_ERROR.help,
+        params::SIMPLIFY_ERROR.default,
+        params::RECONSTRUCT_ERROR.default,
+        Metric::L21.default_error(),
+        Metric::Density.default_error()
+    )
+}
+
+/// `--tree`: the choices of the table's `tree_kind`, in their order.
+#[derive(Clone, Copy)]
 pub(crate) enum Kind {
-    /// Octree far from the surface, quadtrees in its tangent planes near it (the paper's).
     Vstree,
-    /// A plain octree with the same metric and bound: the baseline to compare with.
     Octree,
 }
+table_choices!(Kind, params::SIMPLIFY_TREE_KIND, [Vstree, Octree]);
 
-#[derive(Clone, Copy, ValueEnum)]
+/// `--metric`: the choices of the table's `metric`.
+#[derive(Clone, Copy)]
 pub(crate) enum MetricArg {
-    /// Quadric error: how far the cluster's point is from its samples' tangent planes.
     L2,
-    /// Normal deviation: how much the cluster's normals differ from their mean.
     L21,
-    /// Sample count: at most `--error` samples per cluster (cheap, for huge inputs).
     Density,
 }
+table_choices!(MetricArg, params::SIMPLIFY_METRIC, [L2, L21, Density]);
 
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+/// `--base-mesh`: the choices of the table's `base_mesh`.
+#[derive(Clone, Copy, PartialEq, Eq)]
 pub(crate) enum BaseMeshArg {
-    /// The points' winding number says inside or outside, the distance to the nearest point how
-    /// far, polygonised on a grid as fine as the smallest T-node (the default before 0.7.0).
     Winding,
-    /// The paper's construction: the T-nodes' planes blended near the points (to compare with).
     Paper,
-    /// The winding number's side, polygonised over the tree's octree, each region at its own
-    /// T-node's size (the field evaluated at the T-layer's corners, not on a fine grid; an open
-    /// output is made on the grid). The default.
     Adaptive,
 }
+table_choices!(BaseMeshArg, params::RECONSTRUCT_BASE_MESH, [Winding, Paper, Adaptive]);
 
-#[derive(Clone, Copy, ValueEnum)]
+/// `--sampling`: the choices of the table's `sampling`.
+#[derive(Clone, Copy)]
 pub(crate) enum Sampling {
-    /// One sample per vertex (normal: area-weighted face normals).
     Vertices,
-    /// One sample per face, at its centre.
     Faces,
 }
+table_choices!(Sampling, params::SIMPLIFY_SAMPLING, [Vertices, Faces]);
 
 /// Whether `simplify` streams its input (see its `--stream`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -296,4 +313,54 @@ pub(crate) fn unsigned<T: TryFrom<i64>>(
 ) -> vstree::Result<T> {
     T::try_from(value)
         .map_err(|_| vstree::Error::InvalidParameter { name, message: format!("{value}: must be {range}") })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+    use vstree::params::{Call, PARAMS};
+
+    /// Every parameter with a flag is that flag on its subcommand, with the table's help,
+    /// default and choices.
+    #[test]
+    fn the_flags_are_the_parameter_table() {
+        let cli = Cli::command();
+        let mut checked = 0;
+        for (command, call) in [("simplify", Call::Simplify), ("reconstruct", Call::Reconstruct)] {
+            let sub = cli.find_subcommand(command).unwrap();
+            for p in PARAMS.iter().filter(|p| p.call == call) {
+                let Some(flag) = p.flag else { continue };
+                let arg = sub
+                    .get_arguments()
+                    .find(|a| a.get_long() == Some(flag))
+                    .unwrap_or_else(|| panic!("{command} has no --{flag} ({})", p.name));
+                let shown = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+                let first = p.help.split(['(', '.']).next().unwrap();
+                assert!(shown.contains(first), "--{flag}: help {shown:?} is not the table's {:?}", p.help);
+                if p.kind == params::Kind::Choice {
+                    let names: Vec<String> =
+                        arg.get_possible_values().iter().map(|v| v.get_name().to_string()).collect();
+                    let table: Vec<&str> = p.choices.iter().map(|c| c.name).collect();
+                    assert_eq!(names, table, "--{flag}");
+                    let default = arg.get_default_values()[0].to_str().unwrap();
+                    assert_eq!(default, p.choices[p.default as usize].name, "--{flag}");
+                } else if let Some(default) = arg.get_default_values().first() {
+                    let value: f64 = default.to_str().unwrap().parse().unwrap();
+                    assert!(
+                        (value - p.default).abs() <= 1e-7 * p.default.abs(),
+                        "--{flag}: {value} against {}",
+                        p.default
+                    );
+                } else {
+                    assert!(
+                        p.kind == params::Kind::Flag || flag == "error" || flag == "faces",
+                        "--{flag} has no default"
+                    );
+                }
+                checked += 1;
+            }
+        }
+        assert!(checked >= 20, "{checked} flags checked");
+    }
 }

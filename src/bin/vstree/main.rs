@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 use vstree::reconstruct::{reconstruct, BaseMesh, Closure, ReconstructParams};
-use vstree::simplify::{simplify, simplify_ply_streaming, KeepTopology, SimplifyParams, SimplifyStats};
+use vstree::simplify::{simplify, simplify_ply_streaming, KeepTopology, SimplifyParams, SimplifyStats, SizeMissed};
 use vstree::tree::{TreeKind, TreeParams};
 use vstree::{io, Progress, SampleSet, Threads};
 
@@ -360,30 +360,18 @@ impl Size {
         Ok(match *self {
             Size::Bound => 0,
             Size::Faces(n) => n,
-            Size::Ratio(r) if triangles == 0 => {
-                return Err(vstree::Error::InvalidParameter {
-                    name: "ratio",
-                    message: format!(
-                        "{r}: the input is a point cloud, with no triangles to take a fraction of: a ratio needs a mesh (use --error)"
-                    ),
-                })
-            }
-            Size::Ratio(r) => ((r * triangles as f64).round() as usize).max(1),
+            Size::Ratio(r) => vstree::simplify::faces_for_ratio(r, triangles as u64)?,
         })
     }
 }
 
-/// Warns when the output is farther from the size asked for than 1% (or 2 triangles): the
-/// topology, or an input with fewer distinct triangles, allowed no closer result.
+/// Warns when the output is farther from the size asked for than the library allows for (see
+/// [`SizeMissed`]): the topology, or an input with fewer distinct triangles, allowed no closer result.
 fn say_size_missed(target: usize, s: &SimplifyStats) {
-    let slack = (target / 100).max(2);
-    if target > 0 && s.output_triangles.abs_diff(target) > slack {
-        let why = if s.output_triangles > target && s.kept_topology {
-            "fewer would change the topology (genus, borders); --no-keep-topology allows it"
-        } else if s.output_triangles > target {
-            "no further edge can collapse without folding the surface or pinching it"
-        } else {
-            "the input has no more distinct clusters to give"
+    if let Some(missed) = SizeMissed::of(target, s.output_triangles, s.kept_topology) {
+        let why = match missed {
+            SizeMissed::Topology => "fewer would change the topology (genus, borders); --no-keep-topology allows it",
+            _ => missed.reason(),
         };
         warn!("vstree: warning: {} triangles instead of the {target} asked for: {why}", s.output_triangles);
     }

@@ -10,7 +10,7 @@ use vstree::tree::TreeStats;
 /// does not follow the cloud at all: a faithful one is within a sample spacing, well below 1%
 /// of the diagonal even for sparse clouds, and the failures seen (a closed blob under an open
 /// hemisphere) are at 30%.
-const FAR_FROM_SAMPLES: f64 = 0.05;
+const SURFACE_LOST_ERROR: f64 = 0.05;
 
 pub(crate) fn print_tree(s: &TreeStats) -> vstree::Result<()> {
     say!("  nodes: {} (V {}, T {}, S {}), depth {}", s.nodes, s.v_nodes, s.t_nodes, s.s_nodes, s.max_depth);
@@ -102,7 +102,7 @@ pub(crate) fn print_reconstruct(
             "closed: {share:.0}% of the closed surface is unsupported by the samples, closed over (--open keeps it open)"
         );
     }
-    if s.final_error > FAR_FROM_SAMPLES {
+    if s.final_error > SURFACE_LOST_ERROR {
         warn!(
             "warning: the surface is far from the samples (RMS {:.1}% of the diagonal) and does not \
              represent this cloud",
