@@ -275,7 +275,7 @@ pub const SIMPLIFY_KEEP_TOPOLOGY: Param = Param::new(
 pub const SIMPLIFY_TARGET_FACES: Param = Param::new(
     Call::Simplify,
     "target_faces",
-    "Target faces",
+    "Target number of faces",
     Kind::Integer,
     "Triangles wanted (instead of the error bound): the tree is grown or cut and quadric edge collapses bring \
      the mesh to this count (within one triangle). Below what the topology allows, the smallest mesh \

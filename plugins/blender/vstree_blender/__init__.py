@@ -146,11 +146,10 @@ def _add_table_properties():
     except core.VstreeUnavailable:
         table = {}
     for cls in classes:
-        # The class's own annotations, never a base class's.
-        own = cls.__dict__.get("__annotations__")
-        if own is None:
-            own = {}
-            cls.__annotations__ = own
+        # The class's own annotations (Python 3.10 and later never hand out a base class's;
+        # 3.14 evaluates them lazily and caches the dict this returns, so it is read here, not
+        # looked up in the class's __dict__).
+        own = cls.__annotations__
         for attribute, call, name in TABLE_PROPERTIES.get(cls.__name__, []):
             p = table.get((call, name))
             own[attribute] = table_property(p) if p is not None else _placeholder(attribute)
