@@ -975,13 +975,13 @@ typedef struct vstree_reconstruct_params {
    */
   double error;
   /**
-   * Height-field test, normal cone (see ::vstree_simplify_params). Unitless, in [0, 1];
-   * default 0. Raising it makes the base mesh denser where curvature is high.
+   * Height-field test, normal cone (see ::vstree_simplify_params). Unitless, in [0, 1)
+   * (at 1 no cell becomes a T-node); default 0. Raising it makes the base mesh denser where curvature is high.
    */
   float d_a;
   /**
-   * Height-field test, displacement (see ::vstree_simplify_params). Unitless, in [0, 1];
-   * default 1/6.
+   * Height-field test, displacement (see ::vstree_simplify_params). Unitless, in (0, 1]
+   * (at 0 no cell becomes a T-node); default 1/6.
    */
   float d_d;
   /**

@@ -384,12 +384,7 @@ mod tests {
             };
             for v in inside {
                 let s = stored(v).unwrap_or_else(|| panic!("{}: {v} does not fit the field", p.name));
-                // The reconstruction's tree needs d_a below 1 and d_d above 0 (stricter than the tree's).
-                let stricter =
-                    S::CALL == Call::Reconstruct && (p.name == "d_a" && v == 1.0 || p.name == "d_d" && v == 0.0);
-                if !stricter && p.name != "threads" {
-                    assert!(s.read().is_ok(), "{}.{} = {v}: refused: {:?}", S::C_NAME, p.name, s.read().err());
-                }
+                assert!(s.read().is_ok(), "{}.{} = {v}: refused: {:?}", S::C_NAME, p.name, s.read().err());
             }
             for v in outside {
                 let Some(s) = stored(v) else { continue };

@@ -35,11 +35,11 @@ pub struct vstree_reconstruct_params {
     /// planes, over the squared bounding-box diagonal. The de-noising control (larger =
     /// smoother, fewer details). Finite and > 0; default 1e-5.
     pub error: f64,
-    /// Height-field test, normal cone (see ::vstree_simplify_params). Unitless, in [0, 1];
-    /// default 0. Raising it makes the base mesh denser where curvature is high.
+    /// Height-field test, normal cone (see ::vstree_simplify_params). Unitless, in [0, 1)
+    /// (at 1 no cell becomes a T-node); default 0. Raising it makes the base mesh denser where curvature is high.
     pub d_a: f32,
-    /// Height-field test, displacement (see ::vstree_simplify_params). Unitless, in [0, 1];
-    /// default 1/6.
+    /// Height-field test, displacement (see ::vstree_simplify_params). Unitless, in (0, 1]
+    /// (at 0 no cell becomes a T-node); default 1/6.
     pub d_d: f32,
     /// Deepest tree level, in [1, 30]; default 24.
     pub max_depth: u32,

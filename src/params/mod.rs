@@ -24,20 +24,6 @@ pub enum Call {
     Normals = 2,
 }
 
-impl Call {
-    /// Every call, in their numbers' order.
-    pub const ALL: [Call; 3] = [Call::Simplify, Call::Reconstruct, Call::Normals];
-
-    /// The call's name as the C API and the bindings spell it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Call::Simplify => "simplify",
-            Call::Reconstruct => "reconstruct",
-            Call::Normals => "normals",
-        }
-    }
-}
-
 /// What values a parameter takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
@@ -188,9 +174,4 @@ impl Param {
 /// The parameter `name` of `call`.
 pub fn find(call: Call, name: &str) -> Option<&'static Param> {
     PARAMS.iter().find(|p| p.call == call && p.name == name)
-}
-
-/// The choice of `param` named `name`.
-pub fn choice(param: &Param, name: &str) -> Option<Choice> {
-    param.choices.iter().find(|c| c.name == name).copied()
 }

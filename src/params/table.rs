@@ -387,8 +387,9 @@ pub const SIMPLIFY_MAX_DEPTH: Param = max_depth(Call::Simplify);
 pub const SIMPLIFY_MIN_CELL_SIZE: Param = min_cell_size(Call::Simplify);
 pub const SIMPLIFY_THREADS: Param = threads(Call::Simplify);
 pub const RECONSTRUCT_ORIENT: Param = orient(Call::Reconstruct);
-pub const RECONSTRUCT_D_A: Param = d_a(Call::Reconstruct);
-pub const RECONSTRUCT_D_D: Param = d_d(Call::Reconstruct);
+// The reconstruction needs T-nodes: at d_a 1 or d_d 0 the height-field test never holds.
+pub const RECONSTRUCT_D_A: Param = d_a(Call::Reconstruct).open(false, true);
+pub const RECONSTRUCT_D_D: Param = d_d(Call::Reconstruct).open(true, false);
 pub const RECONSTRUCT_MAX_DEPTH: Param = max_depth(Call::Reconstruct);
 pub const RECONSTRUCT_MIN_CELL_SIZE: Param = min_cell_size(Call::Reconstruct);
 pub const RECONSTRUCT_NEIGHBOURS: Param = neighbours(Call::Reconstruct);
