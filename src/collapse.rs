@@ -396,6 +396,11 @@ impl Collapser {
         self.faces(v).map(|f| self.triangles[f as usize])
     }
 
+    /// The live faces, in their order, with the vertices' own numbers.
+    pub(crate) fn live_triangles(&self) -> Vec<[u32; 3]> {
+        self.triangles.iter().zip(&self.alive_face).filter(|(_, &alive)| alive).map(|(t, _)| *t).collect()
+    }
+
     /// The mesh of the surviving vertices, each at the mean of the vertices it absorbed, and
     /// the survivors' labels.
     pub(crate) fn finish(self, labels: &[u32]) -> (Mesh, Vec<u32>) {

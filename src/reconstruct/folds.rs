@@ -22,7 +22,7 @@ pub(crate) fn is_folded(s: &Surface, t: &[u32; 3]) -> bool {
 /// Two faces sharing an edge are folded onto each other where their normals differ by more
 /// than this many degrees (the benchmark's fold): a surface sampled finer than its triangles
 /// rarely bends so sharply between two of them, so one of them most likely lies on the wrong side.
-const FOLD_DEGREES: f32 = 150.0;
+pub(crate) const FOLD_DEGREES: f32 = 150.0;
 
 /// The corners of triangles whose normal points against the sum of their corners' normals.
 pub(crate) fn folded_vertices(s: &Surface) -> Vec<usize> {
@@ -54,13 +54,20 @@ const UNFOLD_ROUNDS: usize = 4;
 /// a thin part disagree): each corner of such a triangle
 /// goes to the mean of its neighbours and back onto the samples' surface, in rounds. From the
 /// second round on, the ring around the vertices still folded moves too: a fold pinned by
-/// its own neighbours needs room. Vertices `border` marks stay.
-pub(crate) fn unfold(s: &mut Surface, border: &[bool], onto: &SampleSurface, reach: f32, threads: &Threads) {
+/// its own neighbours needs room. Vertices `border` marks stay. Returns the vertices still
+/// folded.
+pub(crate) fn unfold(
+    s: &mut Surface,
+    border: &[bool],
+    onto: &SampleSurface,
+    reach: f32,
+    threads: &Threads,
+) -> Vec<usize> {
     // The triangles stay the same while their corners move: which faces meet is found once.
     let pairs = threads.run(|| crate::topology::adjacent_face_pairs(&s.triangles));
     let mut folded = threads.run(|| folded_or_creased_vertices(s, &pairs));
     if folded.is_empty() {
-        return;
+        return folded;
     }
     let neighbours = Rows::neighbours(&s.triangles, s.positions.len());
     for round in 0..UNFOLD_ROUNDS {
@@ -92,9 +99,10 @@ pub(crate) fn unfold(s: &mut Surface, border: &[bool], onto: &SampleSurface, rea
         }
         folded = threads.run(|| folded_or_creased_vertices(s, &pairs));
         if folded.is_empty() {
-            return;
+            break;
         }
     }
+    folded
 }
 
 #[cfg(test)]

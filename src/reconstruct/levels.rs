@@ -2,16 +2,17 @@
 //! local fits ([`mls`]) and remeshed ([`relax`]); then level after level is split 1-to-4 on PN
 //! triangles and displaced by the quadtrees ([`refine`]), the new vertices relaxed and projected
 //! and folds unfolded, until the mesh is close enough to the samples or the quadtrees have no
-//! detail left. Without a target distance every triangle is split at every level; with one,
-//! only the regions of M0 ([`Regions`]) whose samples are still farther from their triangles
-//! than the target, so that the triangles go where the detail is, with crack-free transitions
+//! detail left; then the folds left, mostly slivers, are collapsed ([`slivers`]). Without a
+//! target distance every triangle is split at every level; with one, only the regions of M0
+//! ([`Regions`]) whose samples are still farther from their triangles than the target, so that
+//! the triangles go where the detail is, with crack-free transitions
 //! ([`red_green`](super::red_green)) between regions that stopped at different levels.
 
 use super::adjacency::Rows;
 use super::base_mesh::Base;
 use super::lookup::Lookup;
 use super::regions::{Regions, REGION_TRIANGLES};
-use super::{folds, mls, refine, relax, ReconstructParams, ReconstructStats, RefinementStop};
+use super::{folds, mls, refine, relax, slivers, ReconstructParams, ReconstructStats, RefinementStop};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
@@ -63,6 +64,8 @@ pub(super) fn refine(
         (grown, of_triangle)
     });
     let mut measured_now = true;
+    // The vertices the last unfolding left folded.
+    let mut still_folded = Vec::new();
     for level in 0..params.max_levels {
         if measured_now && gap.rms <= f64::from(target) {
             stats.stopped = RefinementStop::Target;
@@ -98,7 +101,7 @@ pub(super) fn refine(
         let border = topology::border_vertices(&surface.triangles, surface.positions.len());
         relax::relax_level(&mut surface, first_new, &border, threads);
         mls::project_vertices(&mut surface, first_new, fit, mls_reach, threads);
-        folds::unfold(&mut surface, &border, fit, mls_reach, threads);
+        still_folded = folds::unfold(&mut surface, &border, fit, mls_reach, threads);
         stats.levels.push(refined.stats);
         crate::memory::release_freed();
         // Without a target distance only the final error is reported: no need to measure
@@ -117,7 +120,9 @@ pub(super) fn refine(
             break;
         }
     }
-    if !measured_now {
+    // What unfolding could not undo: slivers, collapsed.
+    stats.sliver_collapses = slivers::collapse_folds(&mut surface, &still_folded, fit, mls_reach, threads);
+    if !measured_now || stats.sliver_collapses > 0 {
         gap = gap_of(&mut surface);
     }
     let d = f64::from(tree.diagonal).max(f64::MIN_POSITIVE);

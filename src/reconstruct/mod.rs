@@ -18,7 +18,8 @@
 //!    quadratic fit of its nearest samples ([`mls`]; more of them the noisier the cloud), until
 //!    the mesh is close enough to the samples or the quadtrees have no detail left. M0 is
 //!    remeshed and each level's new vertices relaxed ([`relax`]), and folds are unfolded onto
-//!    the samples' fit ([`folds::unfold`]);
+//!    the samples' fit ([`folds::unfold`]); what unfolding leaves after the last level, mostly
+//!    slivers, is collapsed ([`slivers`]);
 //! 4. where much of the closed surface has no sample supporting it (an open scan; see
 //!    [`Closure`]), only the supported part is kept ([`support`]), and faces past the scan's
 //!    border trimmed ([`trim`]).
@@ -47,6 +48,7 @@ mod red_green;
 mod refine;
 mod regions;
 mod relax;
+mod slivers;
 mod support;
 mod t_layer;
 mod thicken;

@@ -218,6 +218,8 @@ pub struct ReconstructStats {
     pub base_error: f64,
     pub final_error: f64,
     pub final_max_error: f64,
+    /// Edges collapsed after the last level to take out folded slivers.
+    pub sliver_collapses: usize,
     pub trimmed_triangles: usize,
     pub output_vertices: usize,
     pub output_triangles: usize,
