@@ -63,7 +63,7 @@ const MIN_T_NODES_PER_COMPONENT: usize = 4;
 /// neighbours', wrapped in the 14 vertices of its star. It is below the grid's resolution,
 /// so it is not a part of the surface that the grid resolves but a bubble of the implicit
 /// function, such as the winding number leaves inside the tube of a sparsely sampled torus.
-fn stray_components(mesh: &Mesh, labels: &[u32], neighbours: &Rows, cell: f32) -> Vec<bool> {
+pub(crate) fn stray_components(mesh: &Mesh, labels: &[u32], neighbours: &Rows, cell: f32) -> Vec<bool> {
     let mut component = vec![u32::MAX; mesh.positions.len()];
     let mut dropped = vec![false; mesh.positions.len()];
     for start in 0..mesh.positions.len() {

@@ -10,6 +10,7 @@
 
 use super::adjacency::Rows;
 use super::base_mesh::Base;
+use super::cluster::stray_components;
 use super::lookup::Lookup;
 use super::regions::{Regions, REGION_TRIANGLES};
 use super::{folds, mls, refine, relax, slivers, ReconstructParams, ReconstructStats, RefinementStop};
@@ -45,6 +46,7 @@ pub(super) fn refine(
     let fit = &near.fit;
     mls::project_vertices(&mut surface, 0, fit, mls_reach, threads);
     relax::improve(&mut surface, fit, mls_reach, threads);
+    stats.base_specks = drop_specks(&mut surface, base.unit);
     let gap_of = |s: &mut refine::Surface| Gap::measure(s, measured, threads);
     let mut gap = gap_of(&mut surface);
     stats.base_error = gap.rms / f64::from(tree.diagonal);
@@ -130,6 +132,29 @@ pub(super) fn refine(
     Ok(surface)
 }
 
+/// Drops the components of M0 that its projection onto the samples squeezed into a box of two
+/// `unit`s (sample spacings or grid cells) a side, or that span fewer than four T-nodes (see
+/// [`stray_components`]): bubbles of the implicit function beside the surface, which the
+/// projection crumples onto one spot of it. Returns how many vertices were dropped (none where
+/// that would leave no face).
+fn drop_specks(s: &mut refine::Surface, unit: f32) -> usize {
+    let mesh = Mesh::new(std::mem::take(&mut s.positions), None, std::mem::take(&mut s.triangles));
+    let neighbours = Rows::neighbours(&mesh.triangles, mesh.positions.len());
+    let dropped = stray_components(&mesh, &s.labels, &neighbours, unit);
+    (s.positions, s.triangles) = (mesh.positions, mesh.triangles);
+    let count = dropped.iter().filter(|&&d| d).count();
+    let kept = |t: &[u32; 3]| !t.iter().any(|&v| dropped[v as usize]);
+    if count == 0 || !s.triangles.iter().any(kept) {
+        return 0;
+    }
+    s.triangles.retain(kept);
+    let kept = super::renumber_used_vertices(&mut s.triangles, s.positions.len());
+    s.positions = kept.iter().map(|&v| s.positions[v]).collect();
+    s.normals = kept.iter().map(|&v| s.normals[v]).collect();
+    s.labels = kept.iter().map(|&v| s.labels[v]).collect();
+    count
+}
+
 /// Marks every region that has more than half its `neighbours` (regions that share an edge)
 /// marked, until none is left: each boundary between refined and unrefined
 /// regions costs irregular vertices (a red-green transition), so a lone region left behind
@@ -189,6 +214,31 @@ impl Gap {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_component_squeezed_below_two_units_is_dropped_and_a_small_part_kept() {
+        // Three closed components, each vertex its own T-node: the surface (radius 1), a
+        // small part 8 units across (kept), and a speck 1.5 units across (dropped), in units of
+        // 0.01.
+        let unit = 0.01;
+        let mut s = refine::Surface::default();
+        for (radius, centre) in [(1.0, Vec3::ZERO), (4.0 * unit, Vec3::X * 2.0), (0.75 * unit, Vec3::Y * 2.0)] {
+            let sphere = crate::eval::shapes::icosphere(radius, 2);
+            let first = s.positions.len() as u32;
+            s.triangles.extend(sphere.triangles.iter().map(|t| t.map(|v| v + first)));
+            s.normals.extend(sphere.positions.iter().map(|p| p.normalize()));
+            s.positions.extend(sphere.positions.iter().map(|&p| p + centre));
+        }
+        s.labels = (0..s.positions.len() as u32).collect();
+        let per_sphere = s.positions.len() / 3;
+        assert_eq!(drop_specks(&mut s, unit), per_sphere);
+        assert_eq!(s.positions.len(), 2 * per_sphere);
+        assert_eq!((s.normals.len(), s.labels.len()), (2 * per_sphere, 2 * per_sphere));
+        assert!(s.positions.iter().all(|p| p.y < 1.0), "the speck at y = 2 is gone");
+        let report = topology::analyze(&Mesh::new(s.positions.clone(), None, s.triangles.clone()));
+        assert!(report.is_watertight());
+        assert_eq!(report.components, 2);
+    }
 
     #[test]
     fn a_region_left_behind_among_refined_ones_is_refined_with_them() {

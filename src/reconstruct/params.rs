@@ -210,6 +210,9 @@ pub struct ReconstructStats {
     pub base_triangles: usize,
     /// Genus of M0 when it is a closed manifold.
     pub base_genus: Option<u32>,
+    /// Vertices of M0's specks dropped: components its projection squeezed below two sample
+    /// spacings.
+    pub base_specks: usize,
     pub levels: Vec<LevelStats>,
     /// Why refinement ended.
     pub stopped: RefinementStop,
