@@ -13,7 +13,7 @@ use super::base_mesh::Base;
 use super::cluster::stray_components;
 use super::lookup::Lookup;
 use super::regions::{Regions, REGION_TRIANGLES};
-use super::{folds, mls, refine, relax, slivers, ReconstructParams, ReconstructStats, RefinementStop};
+use super::{folds, mls, refine, relax, slivers, trim, ReconstructParams, ReconstructStats, RefinementStop};
 use crate::error::Result;
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Threads};
@@ -123,7 +123,10 @@ pub(super) fn refine(
         }
     }
     // What unfolding could not undo: slivers, collapsed.
-    stats.sliver_collapses = slivers::collapse_folds(&mut surface, &still_folded, fit, mls_reach, threads);
+    // What unfolding could not undo: slivers, collapsed. On an open output only near the
+    // samples: what lies beyond them is trimmed, and must stay as the trim finds it.
+    let kept_part = base.open.then(|| (near.index(), trim::BORDER_TRIM * near.spacing));
+    stats.sliver_collapses = slivers::collapse_folds(&mut surface, &still_folded, fit, mls_reach, kept_part, threads);
     if !measured_now || stats.sliver_collapses > 0 {
         gap = gap_of(&mut surface);
     }

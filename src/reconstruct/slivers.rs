@@ -17,6 +17,7 @@ use super::refine::Surface;
 use crate::collapse::Collapser;
 use crate::mesh::Mesh;
 use crate::progress::Threads;
+use crate::spatial::KdTree;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -26,18 +27,26 @@ const ROUNDS: usize = 8;
 /// Collapses edges of the folded faces around `folded` (the vertices [`folds::unfold`] left
 /// folded) where that leaves fewer folds; returns how many were collapsed. Merged-away vertices
 /// leave `s`; the others keep their order. A new position moved onto `onto` travels at most
-/// `reach`.
+/// `reach`. With `within` (samples and a distance), only vertices that near a sample move or
+/// merge: faces with every corner farther stay as they are.
 pub(crate) fn collapse_folds(
     s: &mut Surface,
     folded: &[usize],
     onto: &SampleSurface,
     reach: f32,
+    within: Option<(&KdTree, f32)>,
     threads: &Threads,
 ) -> usize {
+    let folded: Vec<usize> = match within {
+        Some((samples, distance)) => {
+            folded.iter().copied().filter(|&v| samples.any_within(s.positions[v], distance)).collect()
+        }
+        None => folded.to_vec(),
+    };
     if folded.is_empty() {
         return 0;
     }
-    let mut local = Local::around(s, folded, threads);
+    let mut local = Local::around(s, &folded, threads);
     let (collapsed, moved) = local.collapse(onto, reach, threads);
     if collapsed + moved > 0 {
         local.write_back(s);
@@ -351,7 +360,7 @@ mod tests {
         let samples = sphere_samples(20_000, 1.0);
         let onto = SampleSurface::new(&samples, &threads).unwrap();
         let (vertices, faces) = (s.positions.len(), s.triangles.len());
-        let collapsed = collapse_folds(s, &folded, &onto, 0.2, &threads);
+        let collapsed = collapse_folds(s, &folded, &onto, 0.2, None, &threads);
         assert_eq!(s.positions.len(), vertices - collapsed, "merged vertices leave");
         assert_eq!(s.triangles.len(), faces - 2 * collapsed);
         let left = folds::folded_or_creased_vertices(s, &crate::topology::adjacent_face_pairs(&s.triangles));
@@ -364,15 +373,35 @@ mod tests {
         collapsed
     }
 
-    #[test]
-    fn a_sliver_folded_over_is_collapsed_and_the_sphere_stays_closed() {
-        // Vertex 0 moved onto a neighbour's place and 2% of their edge past it: the faces
-        // between them are slivers folded over.
+    /// The icosphere with vertex 0 moved onto a neighbour's place and 2% of their edge past
+    /// it: the faces between them are slivers folded over.
+    fn pushed_sliver() -> Surface {
         let mut s = icosphere();
         let neighbour = ring(&s, 0)[0] as usize;
         let (p, q) = (s.positions[0], s.positions[neighbour]);
         s.positions[0] = (q + 0.02 * (q - p)).normalize();
+        s
+    }
+
+    #[test]
+    fn a_sliver_folded_over_is_collapsed_and_the_sphere_stays_closed() {
+        let mut s = pushed_sliver();
         assert!(collapse_on_the_sphere(&mut s) >= 1);
+    }
+
+    #[test]
+    fn only_vertices_near_the_given_samples_change() {
+        // The folded sliver of the test above, with samples only at the far pole: an open
+        // output's part beyond its samples is left as the trim will find it.
+        let mut s = pushed_sliver();
+        let far_pole = KdTree::new(&[-s.positions[0]]).unwrap();
+        let threads = Threads::new(1).unwrap();
+        let folded = folds::folded_or_creased_vertices(&s, &crate::topology::adjacent_face_pairs(&s.triangles));
+        let samples = sphere_samples(20_000, 1.0);
+        let onto = SampleSurface::new(&samples, &threads).unwrap();
+        let before = s.clone();
+        assert_eq!(collapse_folds(&mut s, &folded, &onto, 0.2, Some((&far_pole, 0.5)), &threads), 0);
+        assert_eq!((s.positions, s.triangles), (before.positions, before.triangles));
     }
 
     #[test]

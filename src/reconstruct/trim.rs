@@ -13,7 +13,7 @@ use rayon::prelude::*;
 /// An open output's border is cut back to this many sample spacings from the samples (see
 /// [`border`]): the samples cannot place a border more finely than their spacing, and within
 /// one spacing of the last samples the cut would wander with each gap between them.
-const BORDER_TRIM: f32 = 2.0;
+pub(super) const BORDER_TRIM: f32 = 2.0;
 /// Bisection steps when a border corner slides back (see [`border`]): to 1/256 of its edge.
 const BORDER_SLIDE_STEPS: usize = 8;
 
