@@ -122,7 +122,6 @@ pub(super) fn refine(
             break;
         }
     }
-    // What unfolding could not undo: slivers, collapsed.
     // What unfolding could not undo: slivers, collapsed. On an open output only near the
     // samples: what lies beyond them is trimmed, and must stay as the trim finds it.
     let kept_part = base.open.then(|| (near.index(), trim::BORDER_TRIM * near.spacing));
@@ -151,10 +150,7 @@ fn drop_specks(s: &mut refine::Surface, unit: f32) -> usize {
         return 0;
     }
     s.triangles.retain(kept);
-    let kept = super::renumber_used_vertices(&mut s.triangles, s.positions.len());
-    s.positions = kept.iter().map(|&v| s.positions[v]).collect();
-    s.normals = kept.iter().map(|&v| s.normals[v]).collect();
-    s.labels = kept.iter().map(|&v| s.labels[v]).collect();
+    s.drop_unused_vertices();
     count
 }
 

@@ -34,6 +34,17 @@ pub(crate) struct Surface {
     pub triangles: Vec<[u32; 3]>,
 }
 
+impl Surface {
+    /// Removes the vertices no triangle uses, with their normals and labels; the others are
+    /// renumbered in the order the triangles first use them.
+    pub fn drop_unused_vertices(&mut self) {
+        let kept = super::renumber_used_vertices(&mut self.triangles, self.positions.len());
+        self.positions = kept.iter().map(|&v| self.positions[v]).collect();
+        self.normals = kept.iter().map(|&v| self.normals[v]).collect();
+        self.labels = kept.iter().map(|&v| self.labels[v]).collect();
+    }
+}
+
 /// What one level did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LevelStats {

@@ -13,6 +13,7 @@
 
 use super::folds::{self, FOLD_DEGREES};
 use super::mls::SampleSurface;
+use super::prepare::keep_unmarked;
 use super::refine::Surface;
 use crate::collapse::Collapser;
 use crate::mesh::Mesh;
@@ -26,7 +27,7 @@ const ROUNDS: usize = 8;
 
 /// Collapses edges of the folded faces around `folded` (the vertices [`folds::unfold`] left
 /// folded) where that leaves fewer folds; returns how many were collapsed. Merged-away vertices
-/// leave `s`; the others keep their order. A new position moved onto `onto` travels at most
+/// leave `s`. A new position moved onto `onto` travels at most
 /// `reach`. With `within` (samples and a distance), only vertices that near a sample move or
 /// merge: faces with every corner farther stay as they are.
 pub(crate) fn collapse_folds(
@@ -56,13 +57,14 @@ pub(crate) fn collapse_folds(
 
 /// The faces within two rings of the folded vertices, renumbered, under collapses.
 struct Local {
-    /// Per local vertex: its index in the surface, position, normal, and whether it may move
-    /// or merge: it was folded, so its star and the faces across its star's edges are local,
-    /// and it is not on a border.
+    /// Per local vertex: its index in the surface, and whether it may move or merge: it was
+    /// folded, so its star and the faces across its star's edges are local, and it is not on a
+    /// border.
     global: Vec<u32>,
-    positions: Vec<Vec3>,
-    normals: Vec<Vec3>,
     movable: Vec<bool>,
+    /// The local vertices' positions and normals; its triangles are the collapser's live
+    /// faces as of the last fold test.
+    s: Surface,
     /// The surface's faces that are local, in order.
     faces: Vec<u32>,
     collapser: Collapser,
@@ -112,11 +114,16 @@ impl Local {
             })
             .collect();
         let positions: Vec<Vec3> = global.iter().map(|&v| s.positions[v as usize]).collect();
-        let normals = global.iter().map(|&v| s.normals[v as usize]).collect();
         let collapser = Collapser::new(&Mesh::new(positions.clone(), None, triangles));
         let movable =
             (0..global.len()).map(|k| ring[global[k] as usize] == 1 && !collapser.is_border(k as u32)).collect();
-        Local { global, positions, normals, movable, faces, collapser }
+        let s = Surface {
+            positions,
+            normals: global.iter().map(|&v| s.normals[v as usize]).collect(),
+            labels: Vec::new(),
+            triangles: Vec::new(),
+        };
+        Local { global, movable, s, faces, collapser }
     }
 
     /// In rounds while any is made: the collapses, shortest candidate edge first, then the moves
@@ -130,7 +137,7 @@ impl Local {
                 .iter()
                 .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
                 .filter(|&(a, b)| self.movable[a as usize] && self.movable[b as usize])
-                .map(|(a, b)| (self.positions[a as usize].distance(self.positions[b as usize]), a, b))
+                .map(|(a, b)| (self.s.positions[a as usize].distance(self.s.positions[b as usize]), a, b))
                 .collect();
             edges.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
             edges.dedup_by_key(|e| (e.1, e.2));
@@ -155,20 +162,16 @@ impl Local {
 
     /// The local faces whose corners are all on folds now (faces facing against their corners'
     /// normals, or turned against a neighbour across an edge by more than [`FOLD_DEGREES`]).
-    fn folded_triangles(&self, threads: &Threads) -> Vec<[u32; 3]> {
-        let s = Surface {
-            positions: self.positions.clone(),
-            normals: self.normals.clone(),
-            labels: Vec::new(),
-            triangles: self.collapser.live_triangles(),
-        };
+    fn folded_triangles(&mut self, threads: &Threads) -> Vec<[u32; 3]> {
+        let s = &mut self.s;
+        s.triangles = self.collapser.live_triangles();
         let pairs = threads.run(|| crate::topology::adjacent_face_pairs(&s.triangles));
-        let folded = threads.run(|| folds::folded_or_creased_vertices(&s, &pairs));
+        let folded = threads.run(|| folds::folded_or_creased_vertices(s, &pairs));
         let mut is_folded = vec![false; s.positions.len()];
         for v in folded {
             is_folded[v] = true;
         }
-        s.triangles.into_iter().filter(|t| t.iter().all(|&v| is_folded[v as usize])).collect()
+        s.triangles.iter().copied().filter(|t| t.iter().all(|&v| is_folded[v as usize])).collect()
     }
 
     /// Moves `v` to the mean of its neighbours, onto the samples' fit or not, where the faces
@@ -182,11 +185,11 @@ impl Local {
             return false;
         }
         let across = self.faces_across(&star, &[v]);
-        let at = |w: u32| (self.positions[w as usize], self.normals[w as usize]);
+        let at = |w: u32| (self.s.positions[w as usize], self.s.normals[w as usize]);
         let before = count_folds(&star, &across, at);
-        let mean = ring.iter().map(|&w| self.positions[w as usize]).sum::<Vec3>() / ring.len() as f32;
-        let normal = ring.iter().map(|&w| self.normals[w as usize]).sum::<Vec3>().normalize_or_zero();
-        let normal = if normal == Vec3::ZERO { self.normals[v as usize] } else { normal };
+        let mean = ring.iter().map(|&w| self.s.positions[w as usize]).sum::<Vec3>() / ring.len() as f32;
+        let normal = ring.iter().map(|&w| self.s.normals[w as usize]).sum::<Vec3>().normalize_or_zero();
+        let normal = if normal == Vec3::ZERO { self.s.normals[v as usize] } else { normal };
         let projected = onto.project(mean, normal).filter(|(p, _)| p.distance(mean) <= reach);
         let best = projected
             .into_iter()
@@ -194,8 +197,8 @@ impl Local {
             .map(|(p, n)| (count_folds(&star, &across, |w| if w == v { (p, n) } else { at(w) }), p, n))
             .min_by_key(|option| option.0);
         let Some((_, p, n)) = best.filter(|best| best.0 < before) else { return false };
-        self.positions[v as usize] = p;
-        self.normals[v as usize] = n;
+        self.s.positions[v as usize] = p;
+        self.s.normals[v as usize] = n;
         true
     }
 
@@ -210,7 +213,7 @@ impl Local {
         star.sort_unstable();
         star.dedup();
         let across = self.faces_across(&star, &[a, b]);
-        let at = |v: u32| (self.positions[v as usize], self.normals[v as usize]);
+        let at = |v: u32| (self.s.positions[v as usize], self.s.normals[v as usize]);
         let before = count_folds(&star, &across, at);
         let merged: Vec<[u32; 3]> = star
             .iter()
@@ -230,8 +233,8 @@ impl Local {
             return false;
         }
         self.collapser.merge(a, b);
-        self.positions[b as usize] = p;
-        self.normals[b as usize] = n;
+        self.s.positions[b as usize] = p;
+        self.s.normals[b as usize] = n;
         true
     }
 
@@ -257,39 +260,17 @@ impl Local {
     /// The collapsed faces back into `s`, and the merged-away vertices out of it.
     fn write_back(self, s: &mut Surface) {
         for (k, &v) in self.global.iter().enumerate() {
-            s.positions[v as usize] = self.positions[k];
-            s.normals[v as usize] = self.normals[k];
+            s.positions[v as usize] = self.s.positions[k];
+            s.normals[v as usize] = self.s.normals[k];
         }
-        let mut keep = vec![true; s.triangles.len()];
+        let mut local = vec![false; s.triangles.len()];
         for &t in &self.faces {
-            keep[t as usize] = false;
+            local[t as usize] = true;
         }
+        keep_unmarked(&mut s.triangles, &local);
         let live = self.collapser.live_triangles();
-        let mut triangles: Vec<[u32; 3]> = s.triangles.iter().zip(&keep).filter(|(_, &k)| k).map(|(t, _)| *t).collect();
-        triangles.extend(live.iter().map(|t| t.map(|v| self.global[v as usize])));
-        let mut alive = vec![true; s.positions.len()];
-        for (k, &v) in self.global.iter().enumerate() {
-            alive[v as usize] = self.collapser.is_alive(k as u32);
-        }
-        let mut index = vec![u32::MAX; s.positions.len()];
-        let mut next = 0u32;
-        for v in 0..s.positions.len() {
-            if alive[v] {
-                index[v] = next;
-                s.positions[next as usize] = s.positions[v];
-                s.normals[next as usize] = s.normals[v];
-                s.labels[next as usize] = s.labels[v];
-                next += 1;
-            }
-        }
-        for list in [&mut s.positions, &mut s.normals] {
-            list.truncate(next as usize);
-        }
-        s.labels.truncate(next as usize);
-        for t in &mut triangles {
-            *t = t.map(|v| index[v as usize]);
-        }
-        s.triangles = triangles;
+        s.triangles.extend(live.iter().map(|t| t.map(|v| self.global[v as usize])));
+        s.drop_unused_vertices();
     }
 }
 
